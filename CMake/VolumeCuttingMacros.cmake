@@ -1,0 +1,82 @@
+# Build helpers that let one layer CMakeLists.txt serve both build modes:
+# Slicer extension mode (Slicer's macros) and Slicer Core mode (VTK modules).
+
+#-----------------------------------------------------------------------------
+# volumecutting_add_library(<kit>
+#   VTK_MODULE <name in vtk.module> EXPORT_DIRECTIVE <macro> SRCS <files...>
+#   [INCLUDE_DIRECTORIES <dirs...>] [TARGET_LIBRARIES <libs...>])
+#
+# Every library exposes <kit>Export.h defining <EXPORT_DIRECTIVE>, as Slicer's
+# macros generate it; in Core mode the header forwards to the VTK module's.
+# TARGET_LIBRARIES are used in extension mode only: in Core mode the
+# dependencies come from vtk.module.
+function(volumecutting_add_library kit)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "VTK_MODULE;EXPORT_DIRECTIVE" "SRCS;INCLUDE_DIRECTORIES;TARGET_LIBRARIES")
+  if(VolumeCutting_BUILD_WITH_SLICER_CORE)
+    set(classes)
+    foreach(source IN LISTS arg_SRCS)
+      if(source MATCHES "^(.*)\\.cxx$")
+        list(APPEND classes ${CMAKE_MATCH_1})
+      endif()
+    endforeach()
+    string(REGEX REPLACE "_EXPORT$" "" export_prefix "${arg_EXPORT_DIRECTIVE}")
+    slicercore_generate_module_wrapper(HEADER_NAME ${kit}Export.h OUTPUT_VAR export_header)
+    vtk_module_add_module(${arg_VTK_MODULE}
+      EXPORT_MACRO_PREFIX ${export_prefix}
+      CLASSES ${classes}
+      HEADERS ${export_header}
+      )
+  else()
+    SlicerMacroBuildModuleLogic(
+      NAME ${kit}
+      EXPORT_DIRECTIVE ${arg_EXPORT_DIRECTIVE}
+      INCLUDE_DIRECTORIES ${arg_INCLUDE_DIRECTORIES}
+      SRCS ${arg_SRCS}
+      TARGET_LIBRARIES ${arg_TARGET_LIBRARIES}
+      )
+  endif()
+endfunction()
+
+#-----------------------------------------------------------------------------
+# volumecutting_add_cxx_tests(<kit> TESTS <names...> [LIBRARIES <libs...>])
+#
+# One test driver per library, one test per <name>.cxx defining
+# `int <name>(int argc, char* argv[])`. The last argument of each test is a
+# writable temporary directory. As Slicer's WITH_VTK_ERROR_OUTPUT_CHECK does,
+# a test fails if it logs VTK warnings or errors it did not expect (tests
+# that provoke errors assert them with TESTING_OUTPUT_ASSERT_* from vtkAddon).
+function(volumecutting_add_cxx_tests kit)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "TESTS;LIBRARIES")
+  set(sources)
+  foreach(test_name IN LISTS arg_TESTS)
+    list(APPEND sources ${test_name}.cxx)
+  endforeach()
+  set(temporary_dir "${CMAKE_BINARY_DIR}/Testing/Temporary")
+  file(MAKE_DIRECTORY "${temporary_dir}")
+  if(VolumeCutting_BUILD_WITH_SLICER_CORE)
+    set(CMAKE_TESTDRIVER_BEFORE_TESTMAIN
+      "  vtkOutputWindow::SetInstance(vtkTestingOutputWindow::GetInstance());\n  vtkTestingOutputWindow::GetInstance()->ResetNumberOfLoggedMessages();\n")
+    set(CMAKE_TESTDRIVER_AFTER_TESTMAIN
+      "  if (result == 0 && vtkTestingOutputWindow::GetInstance()->GetNumberOfLoggedWarningErrorMessages() > 0)\n  {\n    std::cerr << \"Test failed: it logged unexpected VTK warnings or errors\" << std::endl;\n    result = 1;\n  }\n")
+    create_test_sourcelist(driver_sources ${kit}CxxTests.cxx ${sources}
+      EXTRA_INCLUDE vtkTestingOutputWindow.h)
+    add_executable(${kit}CxxTests ${driver_sources})
+    target_link_libraries(${kit}CxxTests PRIVATE ${arg_LIBRARIES} vtkAddon)
+    foreach(test_name IN LISTS arg_TESTS)
+      add_test(NAME ${kit}.${test_name} COMMAND ${kit}CxxTests ${test_name} "${temporary_dir}")
+      set_tests_properties(${kit}.${test_name} PROPERTIES LABELS "cxx;${kit}")
+    endforeach()
+  else()
+    set(KIT ${kit})
+    slicerMacroConfigureModuleCxxTestDriver(
+      NAME ${kit}
+      SOURCES ${sources}
+      TARGET_LIBRARIES ${arg_LIBRARIES}
+      WITH_VTK_DEBUG_LEAKS_CHECK
+      WITH_VTK_ERROR_OUTPUT_CHECK
+      )
+    foreach(test_name IN LISTS arg_TESTS)
+      simple_test(${test_name} "${temporary_dir}")
+    endforeach()
+  endif()
+endfunction()

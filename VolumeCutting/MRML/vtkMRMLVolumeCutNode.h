@@ -1,0 +1,141 @@
+/*==============================================================================
+
+  VolumeCutting: virtual bone drilling and volume cutting for 3D Slicer.
+
+  Licensed under the Apache License, Version 2.0 (the "License");
+  you may not use this file except in compliance with the License.
+  You may obtain a copy of the License at http://www.apache.org/licenses/LICENSE-2.0
+
+==============================================================================*/
+
+#ifndef vtkMRMLVolumeCutNode_h
+#define vtkMRMLVolumeCutNode_h
+
+// MRML includes
+#include <vtkMRMLNode.h>
+
+// STD includes
+#include <string>
+#include <vector>
+
+#include "vtkSlicerVolumeCuttingModuleMRMLExport.h"
+
+class vtkMRMLScalarVolumeNode;
+class vtkMRMLSegmentationNode;
+
+/// \brief Parameters of one volume-cutting session on one anatomy.
+///
+/// The node ties the anatomy (a CT as a scalar volume and its segmentation) to
+/// what the tools may do with it: which segments a tool may cut, which are
+/// protected (critical structures such as the facial nerve, which are never
+/// removed), the sub-voxel factor of the cut field, and the active tool.
+///
+/// The anatomy itself is never modified by cutting: the removed region lives in
+/// a separate cut field (multivolume scheme of Pflesser et al., 2002), so the
+/// node only references the anatomy.
+///
+/// A segment has at most one role: setting a segment cuttable clears its
+/// protected role and vice versa. Roles refer to segment IDs of the referenced
+/// segmentation; when a segment is removed from it, its role is dropped.
+///
+/// \sa vtkSlicerVolumeCuttingLogic
+class VTK_SLICER_VOLUMECUTTING_MODULE_MRML_EXPORT vtkMRMLVolumeCutNode : public vtkMRMLNode
+{
+public:
+  static vtkMRMLVolumeCutNode* New();
+  vtkTypeMacro(vtkMRMLVolumeCutNode, vtkMRMLNode);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  vtkMRMLNode* CreateNodeInstance() override;
+  const char* GetNodeTagName() override { return "VolumeCut"; }
+
+  void ReadXMLAttributes(const char** atts) override;
+  void WriteXML(ostream& of, int indent) override;
+  vtkMRMLCopyContentMacro(vtkMRMLVolumeCutNode);
+
+  void ProcessMRMLEvents(vtkObject* caller, unsigned long event, void* callData) override;
+
+  enum
+  {
+    /// Invoked when the content of a referenced input (anatomy voxels or
+    /// segments) changes, so that derived data (cut field geometry,
+    /// renderer inputs) can be updated.
+    InputDataModifiedEvent = 27300,
+    /// Invoked when the role of any segment changes.
+    SegmentRolesModifiedEvent
+  };
+
+  ///@{
+  /// Anatomy volume (CT in Hounsfield units) the cut field is aligned with.
+  void SetAndObserveAnatomyVolumeNodeID(const char* nodeId);
+  const char* GetAnatomyVolumeNodeID();
+  vtkMRMLScalarVolumeNode* GetAnatomyVolumeNode();
+  ///@}
+
+  ///@{
+  /// Segmentation of the anatomy whose segments receive roles.
+  void SetAndObserveSegmentationNodeID(const char* nodeId);
+  const char* GetSegmentationNodeID();
+  vtkMRMLSegmentationNode* GetSegmentationNode();
+  ///@}
+
+  ///@{
+  /// Node that describes the active cutting tool (shape, size, sensibility).
+  void SetAndObserveActiveToolNodeID(const char* nodeId);
+  const char* GetActiveToolNodeID();
+  vtkMRMLNode* GetActiveToolNode();
+  ///@}
+
+  ///@{
+  /// Segments a tool may remove. An ID that is also protected is dropped from
+  /// this list: protection wins, since removing a critical structure is the
+  /// error the user must never be exposed to.
+  void SetCuttableSegmentIDs(const std::vector<std::string>& segmentIds);
+  std::vector<std::string> GetCuttableSegmentIDs() const { return this->CuttableSegmentIDs; }
+  ///@}
+
+  ///@{
+  /// Segments that are never removed and whose contact is reported.
+  void SetProtectedSegmentIDs(const std::vector<std::string>& segmentIds);
+  std::vector<std::string> GetProtectedSegmentIDs() const { return this->ProtectedSegmentIDs; }
+  ///@}
+
+  ///@{
+  /// Give a segment the cuttable or protected role, or take it away.
+  /// Returns false, logs an error and changes nothing if no segmentation is
+  /// referenced or the segmentation has no segment with this ID.
+  bool SetSegmentCuttable(const std::string& segmentId, bool cuttable);
+  bool SetSegmentProtected(const std::string& segmentId, bool isProtected);
+  bool IsSegmentCuttable(const std::string& segmentId) const;
+  bool IsSegmentProtected(const std::string& segmentId) const;
+  ///@}
+
+  ///@{
+  /// Resolution of the cut field relative to the anatomy's voxels along each
+  /// axis: 1, 2 or 4. Other values are rejected with an error.
+  /// Default is 2.
+  void SetSubVoxelFactor(int factor);
+  vtkGetMacro(SubVoxelFactor, int);
+  static bool IsValidSubVoxelFactor(int factor);
+  ///@}
+
+protected:
+  vtkMRMLVolumeCutNode();
+  ~vtkMRMLVolumeCutNode() override;
+  vtkMRMLVolumeCutNode(const vtkMRMLVolumeCutNode&) = delete;
+  void operator=(const vtkMRMLVolumeCutNode&) = delete;
+
+  /// Whether the referenced segmentation has this segment; logs an error if not.
+  bool CheckSegmentExists(const std::string& segmentId, const char* caller);
+  void RemoveSegmentRoles(const std::string& segmentId);
+
+  static const char* AnatomyVolumeReferenceRole;
+  static const char* SegmentationReferenceRole;
+  static const char* ActiveToolReferenceRole;
+
+  std::vector<std::string> CuttableSegmentIDs;
+  std::vector<std::string> ProtectedSegmentIDs;
+  int SubVoxelFactor{ 2 };
+};
+
+#endif
