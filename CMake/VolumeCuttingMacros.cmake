@@ -64,7 +64,12 @@ function(volumecutting_add_cxx_tests kit)
     target_link_libraries(${kit}CxxTests PRIVATE ${arg_LIBRARIES} vtkAddon)
     foreach(test_name IN LISTS arg_TESTS)
       add_test(NAME ${kit}.${test_name} COMMAND ${kit}CxxTests ${test_name} "${temporary_dir}")
-      set_tests_properties(${kit}.${test_name} PROPERTIES LABELS "cxx;${kit}")
+      # The wheel's libvtkAddon.so has a RUNPATH that misses vtkmodules/: in
+      # Python the libraries are loaded already, here the loader needs the path.
+      string(REPLACE ";" ":" runtime_path "${VolumeCutting_WHEEL_RUNTIME_DIRS}")
+      set_tests_properties(${kit}.${test_name} PROPERTIES
+        LABELS "cxx;${kit}"
+        ENVIRONMENT "LD_LIBRARY_PATH=${runtime_path}")
     endforeach()
   else()
     set(KIT ${kit})

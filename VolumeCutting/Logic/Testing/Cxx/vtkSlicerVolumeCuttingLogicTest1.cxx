@@ -1,0 +1,228 @@
+/*==============================================================================
+
+  VolumeCutting: virtual bone drilling and volume cutting for 3D Slicer.
+
+  Licensed under the Apache License, Version 2.0 (the "License");
+  you may not use this file except in compliance with the License.
+  You may obtain a copy of the License at http://www.apache.org/licenses/LICENSE-2.0
+
+==============================================================================*/
+
+// VolumeCutting includes
+#include "vtkMRMLVolumeCutNode.h"
+#include "vtkSlicerVolumeCuttingLogic.h"
+
+// MRML includes
+#include <vtkMRMLMessageCollection.h>
+#include <vtkMRMLScalarVolumeNode.h>
+#include <vtkMRMLScene.h>
+#include <vtkMRMLSegmentationNode.h>
+
+// SegmentationCore includes
+#include <vtkOrientedImageData.h>
+#include <vtkSegment.h>
+#include <vtkSegmentation.h>
+#include <vtkSegmentationConverter.h>
+
+// vtkAddon includes
+#include <vtkAddonTestingMacros.h>
+#include <vtkTestingOutputWindow.h>
+
+// VTK includes
+#include <vtkCommand.h>
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+
+// STD includes
+#include <cmath>
+
+namespace
+{
+// Ball of trabecular bone (radius 6 voxels) in a 2-voxel cortical shell, on an
+// oblique, anisotropic grid: the labels must come back on exactly that grid.
+vtkMRMLScalarVolumeNode* AddBallVolume(vtkMRMLScene* scene, int& expectedCortical, int& expectedTrabecular)
+{
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(24, 24, 20);
+  image->AllocateScalars(VTK_SHORT, 1);
+  expectedCortical = 0;
+  expectedTrabecular = 0;
+  for (int k = 0; k < 20; ++k)
+  {
+    for (int j = 0; j < 24; ++j)
+    {
+      for (int i = 0; i < 24; ++i)
+      {
+        const double r = std::sqrt((i - 12.0) * (i - 12.0) + (j - 12.0) * (j - 12.0) + (k - 10.0) * (k - 10.0));
+        short value = -1000;
+        if (r <= 6.0)
+        {
+          value = 500;
+          ++expectedTrabecular;
+        }
+        else if (r <= 8.0)
+        {
+          value = 1500;
+          ++expectedCortical;
+        }
+        image->SetScalarComponentFromDouble(i, j, k, 0, value);
+      }
+    }
+  }
+  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(scene->AddNewNodeByClass("vtkMRMLScalarVolumeNode", "Ball"));
+  volume->SetAndObserveImageData(image);
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  // 30 degrees about the S axis, spacing 0.5 x 0.5 x 0.8 mm.
+  const double c = std::cos(3.14159265358979 / 6.0);
+  const double s = std::sin(3.14159265358979 / 6.0);
+  const double spacing[3] = { 0.5, 0.5, 0.8 };
+  const double axes[3][3] = { { c, s, 0 }, { -s, c, 0 }, { 0, 0, 1 } };
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      ijkToRas->SetElement(row, column, axes[column][row] * spacing[column]);
+    }
+  }
+  ijkToRas->SetElement(0, 3, -10.0);
+  ijkToRas->SetElement(1, 3, 5.0);
+  ijkToRas->SetElement(2, 3, 30.0);
+  volume->SetIJKToRASMatrix(ijkToRas);
+  return volume;
+}
+
+int CountVoxels(vtkOrientedImageData* labelmap)
+{
+  int count = 0;
+  int extent[6];
+  labelmap->GetExtent(extent);
+  for (int k = extent[4]; k <= extent[5]; ++k)
+  {
+    for (int j = extent[2]; j <= extent[3]; ++j)
+    {
+      for (int i = extent[0]; i <= extent[1]; ++i)
+      {
+        count += labelmap->GetScalarComponentAsDouble(i, j, k, 0) > 0;
+      }
+    }
+  }
+  return count;
+}
+
+int TestBoneSegmentationAndCutNode()
+{
+  vtkNew<vtkMRMLScene> scene;
+  vtkNew<vtkSlicerVolumeCuttingLogic> logic;
+  logic->SetMRMLScene(scene);
+  CHECK_BOOL(scene->IsNodeClassRegistered("vtkMRMLVolumeCutNode"), true);
+
+  int expectedCortical = 0;
+  int expectedTrabecular = 0;
+  vtkMRMLScalarVolumeNode* volume = AddBallVolume(scene, expectedCortical, expectedTrabecular);
+  vtkMRMLSegmentationNode* bone = logic->CreateBoneSegmentation(volume);
+  CHECK_NOT_NULL(bone);
+  vtkSegmentation* segmentation = bone->GetSegmentation();
+  CHECK_INT(segmentation->GetNumberOfSegments(), 2);
+  CHECK_NOT_NULL(segmentation->GetSegment(vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID()));
+
+  vtkOrientedImageData* cortical = bone->GetBinaryLabelmapInternalRepresentation(vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID());
+  vtkOrientedImageData* trabecular = bone->GetBinaryLabelmapInternalRepresentation(vtkSlicerVolumeCuttingLogic::GetTrabecularBoneSegmentID());
+  CHECK_NOT_NULL(cortical);
+  CHECK_NOT_NULL(trabecular);
+  CHECK_INT(CountVoxels(cortical), expectedCortical);
+  CHECK_INT(CountVoxels(trabecular), expectedTrabecular);
+
+  // Same grid as the CT, oblique axes included.
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  volume->GetIJKToRASMatrix(ijkToRas);
+  vtkNew<vtkMatrix4x4> labelmapToWorld;
+  cortical->GetImageToWorldMatrix(labelmapToWorld);
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      CHECK_DOUBLE_TOLERANCE(labelmapToWorld->GetElement(row, column), ijkToRas->GetElement(row, column), 1e-9);
+    }
+  }
+
+  vtkMRMLVolumeCutNode* cutNode = logic->AddVolumeCutNode(volume, bone);
+  CHECK_NOT_NULL(cutNode);
+  CHECK_POINTER(cutNode->GetAnatomyVolumeNode(), volume);
+  CHECK_POINTER(cutNode->GetSegmentationNode(), bone);
+  CHECK_BOOL(cutNode->SetSegmentCuttable(vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID(), true), true);
+
+  vtkNew<vtkMRMLMessageCollection> messages;
+  CHECK_BOOL(logic->CheckInputs(cutNode, messages), true);
+  CHECK_INT(messages->GetNumberOfMessages(), 0);
+  return EXIT_SUCCESS;
+}
+
+int TestCheckInputsReportsProblems()
+{
+  vtkNew<vtkMRMLScene> scene;
+  vtkNew<vtkSlicerVolumeCuttingLogic> logic;
+  logic->SetMRMLScene(scene);
+  int cortical = 0;
+  int trabecular = 0;
+  vtkMRMLScalarVolumeNode* volume = AddBallVolume(scene, cortical, trabecular);
+
+  // Null node and missing anatomy are errors.
+  vtkNew<vtkMRMLMessageCollection> messages;
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(logic->CheckInputs(nullptr, messages), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  vtkMRMLVolumeCutNode* cutNode = logic->AddVolumeCutNode(nullptr, nullptr);
+  messages->ClearMessages();
+  TESTING_OUTPUT_IGNORE_WARNINGS_ERRORS_BEGIN();
+  CHECK_BOOL(logic->CheckInputs(cutNode, messages), false);
+  TESTING_OUTPUT_IGNORE_WARNINGS_ERRORS_END();
+  CHECK_INT(messages->GetNumberOfMessagesOfType(vtkCommand::ErrorEvent), 1);
+  CHECK_INT(messages->GetNumberOfMessagesOfType(vtkCommand::WarningEvent), 1);
+
+  // A segmentation on another grid is a warning, not an error.
+  vtkMRMLSegmentationNode* other = vtkMRMLSegmentationNode::SafeDownCast(scene->AddNewNodeByClass("vtkMRMLSegmentationNode", "Other grid"));
+  vtkNew<vtkOrientedImageData> mask;
+  mask->SetDimensions(10, 10, 10);
+  mask->SetSpacing(1.0, 1.0, 1.0);
+  mask->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  vtkNew<vtkSegment> segment;
+  segment->AddRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName(), mask);
+  other->GetSegmentation()->AddSegment(segment, "Nerve");
+  cutNode->SetAndObserveAnatomyVolumeNodeID(volume->GetID());
+  cutNode->SetAndObserveSegmentationNodeID(other->GetID());
+  messages->ClearMessages();
+  TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
+  CHECK_BOOL(logic->CheckInputs(cutNode, messages), true);
+  TESTING_OUTPUT_ASSERT_WARNINGS_END();
+  CHECK_INT(messages->GetNumberOfMessagesOfType(vtkCommand::WarningEvent), 1);
+  CHECK_BOOL(messages->GetAllMessagesAsString().find("voxel grid") != std::string::npos, true);
+
+  // An anatomy without voxels is an error; so is a bone segmentation of it.
+  vtkMRMLScalarVolumeNode* empty = vtkMRMLScalarVolumeNode::SafeDownCast(scene->AddNewNodeByClass("vtkMRMLScalarVolumeNode", "Empty"));
+  cutNode->SetAndObserveAnatomyVolumeNodeID(empty->GetID());
+  messages->ClearMessages();
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(logic->CheckInputs(cutNode, messages), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  const int nodesBefore = scene->GetNumberOfNodes();
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_NULL(logic->CreateBoneSegmentation(empty));
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_INT(scene->GetNumberOfNodes(), nodesBefore);
+
+  // Thresholds in the wrong order: error, nothing added.
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_NULL(logic->CreateBoneSegmentation(volume, 100.0, 500.0));
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_INT(scene->GetNumberOfNodes(), nodesBefore);
+  return EXIT_SUCCESS;
+}
+} // namespace
+
+int vtkSlicerVolumeCuttingLogicTest1(int, char*[])
+{
+  CHECK_EXIT_SUCCESS(TestBoneSegmentationAndCutNode());
+  CHECK_EXIT_SUCCESS(TestCheckInputsReportsProblems());
+  return EXIT_SUCCESS;
+}

@@ -1,0 +1,81 @@
+/*==============================================================================
+
+  VolumeCutting: virtual bone drilling and volume cutting for 3D Slicer.
+
+  Licensed under the Apache License, Version 2.0 (the "License");
+  you may not use this file except in compliance with the License.
+  You may obtain a copy of the License at http://www.apache.org/licenses/LICENSE-2.0
+
+==============================================================================*/
+
+#ifndef vtkSlicerVolumeCuttingLogic_h
+#define vtkSlicerVolumeCuttingLogic_h
+
+// Slicer includes
+#include <vtkSlicerModuleLogic.h>
+
+// STD includes
+#include <string>
+
+#include "vtkSlicerVolumeCuttingModuleLogicExport.h"
+
+class vtkMRMLMessageCollection;
+class vtkMRMLScalarVolumeNode;
+class vtkMRMLSegmentationNode;
+class vtkMRMLVolumeCutNode;
+
+/// \brief Builds and checks volume-cutting sessions.
+///
+/// The logic is thin on purpose: algorithms live in the Slicer-independent
+/// vtkVolumeCuttingCore library, and this class connects them to MRML nodes.
+/// Any source of work (the module widget, a Python script, a replay) uses the
+/// same methods, so they are tested without a GUI.
+class VTK_SLICER_VOLUMECUTTING_MODULE_LOGIC_EXPORT vtkSlicerVolumeCuttingLogic : public vtkSlicerModuleLogic
+{
+public:
+  static vtkSlicerVolumeCuttingLogic* New();
+  vtkTypeMacro(vtkSlicerVolumeCuttingLogic, vtkSlicerModuleLogic);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Segment IDs of the bone segmentation made by CreateBoneSegmentation.
+  static const char* GetCorticalBoneSegmentID() { return "CorticalBone"; }
+  static const char* GetTrabecularBoneSegmentID() { return "TrabecularBone"; }
+
+  /// Segment the anatomy's bone into cortical and trabecular segments by
+  /// region growing (vtkImageBoneSegmentation) and add the segmentation to the
+  /// scene, on the anatomy's voxel grid. Thresholds are in the volume's units
+  /// (Hounsfield units for CT); smoothing is a Gaussian standard deviation in
+  /// millimetres, 0 for none.
+  /// Returns nullptr and logs an error if the volume has no voxels or the
+  /// thresholds are invalid; nothing is added to the scene then.
+  vtkMRMLSegmentationNode* CreateBoneSegmentation(vtkMRMLScalarVolumeNode* anatomyVolume,
+                                                  double corticalThreshold = 700.0,
+                                                  double trabecularThreshold = 200.0,
+                                                  double smoothingStandardDeviationMm = 0.0);
+
+  /// Add a volume-cut node for this anatomy and segmentation (either may be
+  /// nullptr and set later). The segmentation's reference geometry is set to
+  /// the anatomy's grid if it has none.
+  vtkMRMLVolumeCutNode* AddVolumeCutNode(vtkMRMLScalarVolumeNode* anatomyVolume, vtkMRMLSegmentationNode* segmentation);
+
+  /// Check that a cut node's inputs can be cut: an anatomy volume with voxels
+  /// and finite positive spacing; a segmentation on the same voxel grid; roles
+  /// that name existing segments. Problems are added to \a messages (errors
+  /// for what prevents cutting, warnings for what degrades it) and logged.
+  /// Returns true when there is no error.
+  bool CheckInputs(vtkMRMLVolumeCutNode* cutNode, vtkMRMLMessageCollection* messages);
+
+protected:
+  vtkSlicerVolumeCuttingLogic();
+  ~vtkSlicerVolumeCuttingLogic() override;
+  vtkSlicerVolumeCuttingLogic(const vtkSlicerVolumeCuttingLogic&) = delete;
+  void operator=(const vtkSlicerVolumeCuttingLogic&) = delete;
+
+  void RegisterNodes() override;
+
+  /// Segments need the labelmap and closed-surface representations; desktop
+  /// Slicer registers their conversion rules at start-up, a bare scene does not.
+  static void RegisterSegmentationConverterRules();
+};
+
+#endif

@@ -1,0 +1,187 @@
+"""The volume-cut node and the module logic from Python, in a real MRML scene.
+
+The classes are reached as ``slicer.<ClassName>``, exactly as Python code written
+for desktop Slicer reaches a loadable module's wrapped classes.
+"""
+
+import numpy as np
+import pytest
+import slicer
+import vtk
+from vtkmodules.util import numpy_support
+
+from VolumeCuttingLib.application import HeadlessSlicer
+
+
+@pytest.fixture
+def scene():
+    # The module logic registers vtkMRMLVolumeCutNode, as the module does at start-up.
+    application = HeadlessSlicer()
+    scene = application.scene
+    scene.volumeCuttingLogic = application.volume_cutting_logic
+    scene.application = application
+    return scene
+
+
+def add_ball_ct(scene, name="CT", spacing=(0.6, 0.6, 1.0)):
+    """A trabecular ball (radius 5 voxels) in a cortical shell (radius 7), in HU."""
+    k, j, i = np.mgrid[0:20, 0:22, 0:22]
+    r = np.sqrt((i - 11.0) ** 2 + (j - 11.0) ** 2 + (k - 10.0) ** 2)
+    voxels = np.full(r.shape, -1000, dtype=np.int16)
+    voxels[r <= 7.0] = 1500
+    voxels[r <= 5.0] = 450
+    image = vtk.vtkImageData()
+    image.SetDimensions(22, 22, 20)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(voxels.ravel(), deep=True, array_type=vtk.VTK_SHORT))
+    volume = scene.AddNewNodeByClass("vtkMRMLScalarVolumeNode", name)
+    volume.SetAndObserveImageData(image)
+    volume.SetSpacing(*spacing)
+    volume.SetOrigin(-5.0, 3.0, 20.0)
+    volume.CreateDefaultDisplayNodes()
+    return volume, int((r <= 5.0).sum()), int(((r > 5.0) & (r <= 7.0)).sum())
+
+
+def test_classes_are_in_the_slicer_namespace():
+    node = slicer.vtkMRMLVolumeCutNode()
+    assert isinstance(node, slicer.vtkMRMLNode)
+    assert node.GetSubVoxelFactor() == 2
+    assert issubclass(slicer.vtkSlicerVolumeCuttingLogic, slicer.vtkSlicerModuleLogic)
+    assert issubclass(slicer.vtkImageBoneSegmentation, vtk.vtkImageAlgorithm)
+
+
+def test_bone_segmentation_and_roles(scene):
+    volume, trabecular_count, cortical_count = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    assert bone is not None
+    cortical_id = logic.GetCorticalBoneSegmentID()
+    trabecular_id = logic.GetTrabecularBoneSegmentID()
+    assert bone.GetSegmentation().GetSegmentIDs() == (cortical_id, trabecular_id)
+
+    def count(segment_id):
+        labelmap = bone.GetBinaryLabelmapInternalRepresentation(segment_id)
+        return int(numpy_support.vtk_to_numpy(labelmap.GetPointData().GetScalars()).astype(bool).sum())
+
+    assert count(cortical_id) == cortical_count
+    assert count(trabecular_id) == trabecular_count
+
+    cut = logic.AddVolumeCutNode(volume, bone)
+    assert cut.GetAnatomyVolumeNode() is volume
+    assert cut.GetSegmentationNode() is bone
+    assert cut.SetSegmentCuttable(trabecular_id, True)
+    assert cut.SetSegmentProtected(cortical_id, True)
+    assert cut.IsSegmentCuttable(trabecular_id)
+    assert cut.GetProtectedSegmentIDs() == (cortical_id,)
+    messages = slicer.vtkMRMLMessageCollection()
+    assert logic.CheckInputs(cut, messages)
+    assert messages.GetNumberOfMessages() == 0
+
+
+def test_unknown_segment_is_refused(scene):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    assert not cut.SetSegmentCuttable("NoSuchSegment", True)
+    assert cut.GetCuttableSegmentIDs() == ()
+
+
+def test_save_scene_file_and_reload(scene, tmp_path):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetSegmentCuttable(logic.GetTrabecularBoneSegmentID(), True)
+    cut.SetSegmentProtected(logic.GetCorticalBoneSegmentID(), True)
+    cut.SetSubVoxelFactor(4)
+
+    bundle = tmp_path / "session.mrb"
+    assert scene.WriteToMRB(str(bundle))
+    assert bundle.stat().st_size > 0
+
+    reloaded = HeadlessSlicer()
+    reloaded.load_bundle(bundle)
+    read = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    assert read is not None
+    assert read.GetSubVoxelFactor() == 4
+    assert read.GetCuttableSegmentIDs() == (logic.GetTrabecularBoneSegmentID(),)
+    assert read.GetProtectedSegmentIDs() == (logic.GetCorticalBoneSegmentID(),)
+    read_volume = read.GetAnatomyVolumeNode()
+    assert read_volume is not None and read_volume.GetImageData() is not None
+    assert np.allclose(read_volume.GetSpacing(), volume.GetSpacing())
+    original = numpy_support.vtk_to_numpy(volume.GetImageData().GetPointData().GetScalars())
+    restored = numpy_support.vtk_to_numpy(read_volume.GetImageData().GetPointData().GetScalars())
+    assert np.array_equal(original, restored)
+    read_bone = read.GetSegmentationNode()
+    assert read_bone is not None
+    assert read_bone.GetSegmentation().GetNumberOfSegments() == 2
+    assert logic.CheckInputs(read, slicer.vtkMRMLMessageCollection())
+
+
+def test_mrml_text_round_trip(scene, tmp_path):
+    cut = scene.AddNewNodeByClass("vtkMRMLVolumeCutNode", "Cut")
+    cut.SetSubVoxelFactor(1)
+    scene_file = tmp_path / "scene.mrml"
+    scene.SetURL(str(scene_file))
+    assert scene.Commit()
+    text = scene_file.read_text()
+    assert "<VolumeCut" in text and 'subVoxelFactor="1"' in text
+    reloaded = slicer.vtkMRMLScene()
+    reloaded.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
+    reloaded.SetURL(str(scene_file))
+    reloaded.Import()
+    assert reloaded.GetFirstNodeByClass("vtkMRMLVolumeCutNode").GetSubVoxelFactor() == 1
+
+
+def test_undo_redo_and_copy(scene):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    trabecular_id = logic.GetTrabecularBoneSegmentID()
+    scene.SetUndoOn()
+    scene.SaveStateForUndo()
+    cut.SetSegmentProtected(trabecular_id, True)
+    cut.SetSubVoxelFactor(1)
+    scene.Undo()
+    cut = scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    assert cut.GetSubVoxelFactor() == 2
+    assert not cut.IsSegmentProtected(trabecular_id)
+    scene.Redo()
+    cut = scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    assert cut.GetSubVoxelFactor() == 1
+    assert cut.IsSegmentProtected(trabecular_id)
+
+    copy = slicer.vtkMRMLVolumeCutNode()
+    copy.CopyContent(cut)
+    assert copy.GetProtectedSegmentIDs() == (trabecular_id,)
+    assert copy.GetSubVoxelFactor() == 1
+
+
+def test_events_follow_the_inputs(scene):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    events = []
+    cut.AddObserver(slicer.vtkMRMLVolumeCutNode.InputDataModifiedEvent, lambda caller, event: events.append("input"))
+    cut.AddObserver(slicer.vtkMRMLVolumeCutNode.SegmentRolesModifiedEvent, lambda caller, event: events.append("roles"))
+    cut.SetSegmentProtected(logic.GetCorticalBoneSegmentID(), True)
+    assert events == ["roles"]
+    bone.GetSegmentation().RemoveSegment(logic.GetCorticalBoneSegmentID())
+    assert not cut.IsSegmentProtected(logic.GetCorticalBoneSegmentID())
+    assert "input" in events
+    scene.RemoveNode(bone)
+    assert cut.GetSegmentationNode() is None
+
+
+def test_bad_inputs_give_errors_not_crashes(scene):
+    logic = scene.volumeCuttingLogic
+    empty = scene.AddNewNodeByClass("vtkMRMLScalarVolumeNode", "Empty")
+    assert logic.CreateBoneSegmentation(empty, 700.0, 200.0, 0.0) is None
+    cut = logic.AddVolumeCutNode(empty, None)
+    messages = slicer.vtkMRMLMessageCollection()
+    assert not logic.CheckInputs(cut, messages)
+    assert "no voxels" in messages.GetAllMessagesAsString()
+    cut.SetSubVoxelFactor(3)
+    assert cut.GetSubVoxelFactor() == 2
