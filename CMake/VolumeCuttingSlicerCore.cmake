@@ -71,6 +71,11 @@ vtk_module_build(
   TEST_DIRECTORY_NAME Testing
   )
 
+option(VolumeCutting_WRAP_PYTHON "Python-wrap the libraries (off for sanitizer builds, which run C++ tests only)" ON)
+if(NOT VolumeCutting_WRAP_PYTHON)
+  return()
+endif()
+
 vtk_module_wrap_python(
   MODULES ${volumecutting_modules}
   PYTHON_PACKAGE ${VolumeCutting_PYTHON_PACKAGE}

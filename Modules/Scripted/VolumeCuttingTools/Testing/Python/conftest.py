@@ -1,0 +1,21 @@
+"""pytest configuration for the VolumeCuttingTools Python tests.
+
+Makes ``VolumeCuttingLib`` importable when the tests are run without
+PYTHONPATH, and registers the ``realdata`` marker used by tests that need the
+real head CT (downloaded once into the user cache, never into the repository).
+"""
+
+import sys
+from pathlib import Path
+
+MODULE_DIR = Path(__file__).resolve().parents[2]
+if str(MODULE_DIR) not in sys.path:
+    sys.path.insert(0, str(MODULE_DIR))
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        "realdata: needs the real head CT from Debian's invesalius-examples package "
+        "(fetched into the user cache on first use; skipped if it cannot be obtained)",
+    )

@@ -1,0 +1,163 @@
+"""The main job: a segmentation-then-drill session without the Slicer GUI.
+
+    python -m VolumeCuttingLib.mainjob [--phantom] [--out DIR]
+
+On the real head CT (Debian's invesalius-examples, fetched at setup) or on the
+procedural temporal-bone phantom, it builds what a user builds in Slicer before
+drilling: the CT as a scalar volume, a bone segmentation (region growing into
+cortical and trabecular bone), and a volume-cut node that says which segments a
+tool may cut and which are protected. It renders the 3D view offscreen through
+Slicer's displayable managers to a PNG and saves the scene as a bundle (.mrb).
+
+Later stages of the product (drilling, exact cut rendering, haptics) extend
+this job; ``summary.json`` records what each stage produced and how long it took.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import slicer
+
+from . import headct, phantom
+from .application import HeadlessSlicer
+
+# Roles of the phantom's segments: what a mastoidectomy drill may remove, and
+# the structures whose injury is the complication the trainee must avoid.
+PHANTOM_CUTTABLE_SEGMENTS = ("MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
+PHANTOM_PROTECTED_SEGMENTS = (
+    "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
+
+
+class Stopwatch:
+    def __init__(self):
+        self.seconds = {}
+
+    def measure(self, name):
+        stopwatch = self
+
+        class _Timer:
+            def __enter__(self):
+                self.start = time.perf_counter()
+
+            def __exit__(self, *exc):
+                stopwatch.seconds[name] = round(time.perf_counter() - self.start, 4)
+
+        return _Timer()
+
+
+def load_anatomy(application: HeadlessSlicer, use_phantom: bool, seed: int):
+    """Return (ct_volume_node, anatomy_segmentation_node or None, description)."""
+    if use_phantom:
+        generated = phantom.generate_phantom(dimensions=(128, 128, 96), spacing=(0.4, 0.4, 0.5), seed=seed)
+        volume, segmentation = phantom.create_phantom_nodes(application.scene, generated)
+        return volume, segmentation, "procedural temporal-bone phantom 128x128x96 at 0.4x0.4x0.5 mm"
+    volume = headct.load_volume_node(application.scene, name="HeadCT")
+    dims = volume.GetImageData().GetDimensions()
+    spacing = volume.GetSpacing()
+    return volume, None, f"Debian invesalius-examples Cranium head CT {dims[0]}x{dims[1]}x{dims[2]} at " + \
+        "x".join(f"{s:.3f}" for s in spacing) + " mm"
+
+
+def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool):
+    segment_ids = set(segmentation_node.GetSegmentation().GetSegmentIDs())
+    if use_phantom:
+        cuttable = [s for s in PHANTOM_CUTTABLE_SEGMENTS if s in segment_ids]
+        protected = [s for s in PHANTOM_PROTECTED_SEGMENTS if s in segment_ids]
+    else:
+        cuttable = [logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()]
+        protected = []
+    cut_node.SetProtectedSegmentIDs(protected)
+    cut_node.SetCuttableSegmentIDs(cuttable)
+
+
+def lateral_camera(view, segmentation_node, segment_ids):
+    """Look at the bone from the patient's right, the surgeon's view of a right mastoid."""
+    bounds = [0.0] * 6
+    segmentation_node.GetBounds(bounds)
+    center = [(bounds[2 * axis] + bounds[2 * axis + 1]) / 2.0 for axis in range(3)]
+    extent = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
+    view.look_at(center, direction=(1.0, 0.0, 0.0), distance=2.2 * extent, view_up=(0.0, 0.0, 1.0))
+
+
+def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> dict:
+    out_dir.mkdir(parents=True, exist_ok=True)
+    timer = Stopwatch()
+    application = HeadlessSlicer()
+    logic = application.volume_cutting_logic
+
+    with timer.measure("load_ct_s"):
+        volume, anatomy_segmentation, description = load_anatomy(application, use_phantom, seed)
+    with timer.measure("bone_segmentation_s"):
+        bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.5)
+    if bone is None:
+        raise RuntimeError("bone segmentation failed (see the log)")
+    roles_segmentation = anatomy_segmentation if anatomy_segmentation is not None else bone
+    cut_node = logic.AddVolumeCutNode(volume, roles_segmentation)
+    assign_roles(cut_node, roles_segmentation, logic, use_phantom)
+    messages = slicer.vtkMRMLMessageCollection()
+    inputs_ok = logic.CheckInputs(cut_node, messages)
+
+    with timer.measure("surface_s"):
+        bone.CreateClosedSurfaceRepresentation()
+        if anatomy_segmentation is not None:
+            # Show the structures the user must see through the bone.
+            anatomy_segmentation.CreateClosedSurfaceRepresentation()
+            display = anatomy_segmentation.GetDisplayNode()
+            for segment_id in anatomy_segmentation.GetSegmentation().GetSegmentIDs():
+                display.SetSegmentVisibility(segment_id, segment_id in PHANTOM_PROTECTED_SEGMENTS)
+            bone.GetDisplayNode().SetOpacity3D(0.35)
+
+    view = application.create_3d_view(*size)
+    lateral_camera(view, bone, None)
+    with timer.measure("first_frame_s"):
+        view.render()
+    image_path = view.screenshot(out_dir / "3d.png")
+    renderer = view.renderer_description()
+
+    with timer.measure("save_scene_s"):
+        bundle = application.save_bundle(out_dir / "scene.mrb")
+
+    segmentation = bone.GetSegmentation()
+    summary = {
+        "anatomy": description,
+        "ct_node": volume.GetName(),
+        "bone_segments": list(segmentation.GetSegmentIDs()),
+        "volume_cut_node": cut_node.GetName(),
+        "cuttable_segments": list(cut_node.GetCuttableSegmentIDs()),
+        "protected_segments": list(cut_node.GetProtectedSegmentIDs()),
+        "sub_voxel_factor": cut_node.GetSubVoxelFactor(),
+        "inputs_ok": bool(inputs_ok),
+        "input_messages": messages.GetAllMessagesAsString(),
+        "renderer": renderer,
+        "image": str(image_path),
+        "scene_bundle": str(bundle),
+        "timings": timer.seconds,
+    }
+    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    view.close()
+    return summary
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--phantom", action="store_true", help="use the procedural temporal-bone phantom instead of the real head CT")
+    parser.add_argument("--out", type=Path, default=None, help="output folder (default: out/headct or out/phantom)")
+    parser.add_argument("--seed", type=int, default=0, help="noise seed of the phantom")
+    args = parser.parse_args(argv)
+    out_dir = args.out or Path("out") / ("phantom" if args.phantom else "headct")
+    try:
+        summary = run(args.phantom, out_dir, seed=args.seed)
+    except (RuntimeError, ValueError, OSError) as error:
+        print(f"main job failed: {error}", file=sys.stderr)
+        return 1
+    print(json.dumps(summary, indent=2))
+    return 0 if summary["inputs_ok"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

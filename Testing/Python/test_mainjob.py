@@ -1,0 +1,63 @@
+"""The main job end to end: real nodes, Slicer's 3D rendering, a bundle that reloads."""
+
+import json
+
+import numpy as np
+import pytest
+import vtk
+from vtkmodules.util import numpy_support
+
+from VolumeCuttingLib import mainjob
+from VolumeCuttingLib.application import HeadlessSlicer
+
+
+def read_png(path):
+    reader = vtk.vtkPNGReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    image = reader.GetOutput()
+    width, height, _ = image.GetDimensions()
+    pixels = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars())
+    return pixels.reshape(height, width, -1)[:, :, :3].astype(int)
+
+
+def foreground_fraction(pixels):
+    """Share of pixels that differ from the background gradient at their row.
+
+    Slicer's 3D view background is a vertical gradient, so each row's leftmost
+    pixel gives that row's background colour.
+    """
+    background = pixels[:, :1, :]
+    return float((np.abs(pixels - background).sum(axis=2) > 30).mean())
+
+
+def check_outputs(summary, out_dir):
+    assert summary["inputs_ok"], summary["input_messages"]
+    pixels = read_png(out_dir / "3d.png")
+    assert pixels.shape == (240, 320, 3)
+    # The bone must fill a good part of the view, and not all of it.
+    assert 0.05 < foreground_fraction(pixels) < 0.95
+    reloaded = HeadlessSlicer()
+    reloaded.load_bundle(out_dir / "scene.mrb")
+    cut = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    assert cut is not None
+    assert list(cut.GetCuttableSegmentIDs()) == summary["cuttable_segments"]
+    assert list(cut.GetProtectedSegmentIDs()) == summary["protected_segments"]
+    assert cut.GetAnatomyVolumeNode() is not None
+    assert cut.GetSegmentationNode() is not None
+    assert json.loads((out_dir / "summary.json").read_text()) == summary
+
+
+def test_main_job_on_the_phantom(tmp_path):
+    summary = mainjob.run(True, tmp_path, seed=3, size=(320, 240))
+    for structure in ("FacialNerve", "SigmoidSinus", "Malleus", "Incus", "Stapes"):
+        assert structure in summary["protected_segments"]
+    assert "MastoidBone" in summary["cuttable_segments"]
+    check_outputs(summary, tmp_path)
+
+
+@pytest.mark.realdata
+def test_main_job_on_the_real_head_ct(tmp_path):
+    summary = mainjob.run(False, tmp_path, size=(320, 240))
+    assert summary["bone_segments"] == ["CorticalBone", "TrabecularBone"]
+    check_outputs(summary, tmp_path)
