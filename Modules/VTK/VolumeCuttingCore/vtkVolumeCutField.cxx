@@ -1,0 +1,856 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutField.h"
+
+#include "vtkFloatArray.h"
+#include "vtkIdList.h"
+#include "vtkImageData.h"
+#include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+vtkStandardNewMacro(vtkVolumeCutField);
+
+namespace
+{
+constexpr int BrickSize = vtkVolumeCutField::BrickSize;
+constexpr int SamplesPerBrick = BrickSize * BrickSize * BrickSize;
+constexpr int16_t Outside = std::numeric_limits<int16_t>::max();
+constexpr int16_t Inside = -Outside;
+
+double DistanceToSegment(const double p[3], const double a[3], const double ab[3], double abLength2)
+{
+  double ap[3] = { p[0] - a[0], p[1] - a[1], p[2] - a[2] };
+  double t = abLength2 > 0.0 ? (ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / abLength2 : 0.0;
+  t = std::min(1.0, std::max(0.0, t));
+  const double d[3] = { ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2] };
+  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+bool IsFinite(const double v[3])
+{
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+void Transform(const double m[4][4], const double in[3], double out[3])
+{
+  for (int row = 0; row < 3; ++row)
+  {
+    out[row] = m[row][0] * in[0] + m[row][1] * in[1] + m[row][2] * in[2] + m[row][3];
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+struct vtkVolumeCutField::Brick
+{
+  explicit Brick(vtkIdType id)
+    : Id(id)
+  {
+    for (auto& value : this->Values)
+    {
+      value.store(Outside, std::memory_order_relaxed);
+    }
+  }
+  const vtkIdType Id;
+  // Seqlock: odd while the writer changes the values.
+  std::atomic<uint32_t> Sequence{ 0 };
+  std::atomic<vtkTypeUInt64> Stamp{ 0 };
+  std::atomic<int16_t> Values[SamplesPerBrick];
+};
+
+//------------------------------------------------------------------------------
+struct vtkVolumeCutField::UndoStep
+{
+  std::vector<std::pair<vtkIdType, BrickValues>> Before;
+  std::vector<std::pair<vtkIdType, BrickValues>> After;
+  size_t MemorySize() const { return (this->Before.size() + this->After.size()) * (SamplesPerBrick * sizeof(int16_t) + 64); }
+};
+
+//------------------------------------------------------------------------------
+vtkVolumeCutField::vtkVolumeCutField()
+{
+  vtkMatrix4x4::Identity(&this->SubIJKToRAS[0][0]);
+  vtkMatrix4x4::Identity(&this->RASToSubIJK[0][0]);
+}
+
+//------------------------------------------------------------------------------
+vtkVolumeCutField::~vtkVolumeCutField() = default;
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutField::GetNumberOfUndoSteps() const
+{
+  return static_cast<int>(this->UndoStack.size());
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutField::GetNumberOfRedoSteps() const
+{
+  return static_cast<int>(this->RedoStack.size());
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int subVoxelFactor)
+{
+  if (!anatomyDimensions || anatomyDimensions[0] < 1 || anatomyDimensions[1] < 1 || anatomyDimensions[2] < 1)
+  {
+    vtkErrorMacro("Initialize: the anatomy must have at least one voxel along each axis");
+    return false;
+  }
+  if (subVoxelFactor != 1 && subVoxelFactor != 2 && subVoxelFactor != 4)
+  {
+    vtkErrorMacro("Initialize: sub-voxel factor " << subVoxelFactor << " is not supported; use 1, 2 or 4");
+    return false;
+  }
+  if (!anatomyIJKToRAS)
+  {
+    vtkErrorMacro("Initialize: no IJK-to-RAS matrix");
+    return false;
+  }
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      if (!std::isfinite(anatomyIJKToRAS->GetElement(row, column)))
+      {
+        vtkErrorMacro("Initialize: the IJK-to-RAS matrix has a value that is not finite");
+        return false;
+      }
+    }
+  }
+  const double determinant = anatomyIJKToRAS->Determinant();
+  if (!(std::abs(determinant) > 1e-12))
+  {
+    vtkErrorMacro("Initialize: the IJK-to-RAS matrix is not invertible (zero spacing?)");
+    return false;
+  }
+  int dimensions[3];
+  int brickDimensions[3];
+  double brickCount = 1.0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    dimensions[axis] = anatomyDimensions[axis] * subVoxelFactor;
+    brickDimensions[axis] = (dimensions[axis] + BrickSize - 1) / BrickSize;
+    brickCount *= brickDimensions[axis];
+  }
+  if (brickCount > static_cast<double>(std::numeric_limits<int32_t>::max()))
+  {
+    vtkErrorMacro("Initialize: the volume is too large for a cut field (" << brickCount << " bricks)");
+    return false;
+  }
+
+  // Sub-voxel s lies at anatomy continuous index (s + 0.5) / f - 0.5: sub-voxels
+  // tile each anatomy voxel, and factor 1 reproduces the anatomy grid.
+  vtkNew<vtkMatrix4x4> subToAnatomy;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    subToAnatomy->SetElement(axis, axis, 1.0 / subVoxelFactor);
+    subToAnatomy->SetElement(axis, 3, 0.5 / subVoxelFactor - 0.5);
+  }
+  vtkNew<vtkMatrix4x4> subToRAS;
+  vtkMatrix4x4::Multiply4x4(anatomyIJKToRAS, subToAnatomy, subToRAS);
+  vtkNew<vtkMatrix4x4> rasToSub;
+  vtkMatrix4x4::Invert(subToRAS, rasToSub);
+
+  this->Reset();
+  std::copy(dimensions, dimensions + 3, this->Dimensions);
+  std::copy(brickDimensions, brickDimensions + 3, this->BrickDimensions);
+  this->SubVoxelFactor = subVoxelFactor;
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      this->SubIJKToRAS[row][column] = subToRAS->GetElement(row, column);
+      this->RASToSubIJK[row][column] = rasToSub->GetElement(row, column);
+    }
+  }
+  double spacing[3];
+  this->GetSubVoxelSpacing(spacing);
+  // The band must hold every sample whose interpolation cell the surface
+  // crosses (up to the cell diagonal away) and their neighbours, whose second
+  // differences correct the interpolation for curvature.
+  this->BandWidth = 3.5 * std::max({ spacing[0], spacing[1], spacing[2] });
+  this->Quantum = this->BandWidth / (Outside - 1);
+  this->HalfDiagonal = 0.5 * std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
+  const vtkIdType totalBricks = static_cast<vtkIdType>(brickCount);
+  this->Directory.reset(new std::atomic<Brick*>[totalBricks]);
+  this->AllocatedBrickIds.reset(new std::atomic<vtkIdType>[totalBricks]);
+  for (vtkIdType id = 0; id < totalBricks; ++id)
+  {
+    this->Directory[id].store(nullptr, std::memory_order_relaxed);
+  }
+  this->Modified();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::Reset()
+{
+  this->Directory.reset();
+  this->AllocatedBrickIds.reset();
+  this->NumberOfAllocatedBricks.store(0, std::memory_order_release);
+  this->OwnedBricks.clear();
+  this->UndoStack.clear();
+  this->RedoStack.clear();
+  this->UndoMemorySize = 0;
+  this->StrokeOpen = false;
+  this->StrokeBefore.clear();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::GetSubVoxelIJKToRAS(vtkMatrix4x4* matrix) const
+{
+  if (matrix)
+  {
+    matrix->DeepCopy(&this->SubIJKToRAS[0][0]);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::GetSubVoxelSpacing(double spacing[3]) const
+{
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    spacing[axis] = std::sqrt(this->SubIJKToRAS[0][axis] * this->SubIJKToRAS[0][axis] + this->SubIJKToRAS[1][axis] * this->SubIJKToRAS[1][axis]
+      + this->SubIJKToRAS[2][axis] * this->SubIJKToRAS[2][axis]);
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ValidateStroke(const double p0[3], const double p1[3], double radius, const char* caller) const
+{
+  if (!this->Directory)
+  {
+    vtkErrorMacro(<< caller << ": the cut field is not initialized");
+    return false;
+  }
+  if (!p0 || !p1 || !IsFinite(p0) || !IsFinite(p1))
+  {
+    vtkErrorMacro(<< caller << ": the tool pose is not finite; nothing was cut");
+    return false;
+  }
+  if (!(radius > 0.0) || !std::isfinite(radius))
+  {
+    vtkErrorMacro(<< caller << ": the tool radius must be a positive number (got " << radius << ")");
+    return false;
+  }
+  const double length = std::sqrt(vtkMath::Distance2BetweenPoints(p0, p1));
+  if (length > this->MaximumStrokeLength)
+  {
+    vtkErrorMacro(<< caller << ": the tool jumped " << length << " mm between two poses, more than the " << this->MaximumStrokeLength
+                  << " mm accepted as one stroke; nothing was cut");
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CutCapsule(const double p0[3], const double p1[3], double radius)
+{
+  return this->ApplyCapsule(p0, p1, radius, Operation::Cut);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::RestoreCapsule(const double p0[3], const double p1[3], double radius)
+{
+  return this->ApplyCapsule(p0, p1, radius, Operation::Restore);
+}
+
+//------------------------------------------------------------------------------
+vtkVolumeCutField::Brick* vtkVolumeCutField::GetOrCreateBrick(vtkIdType brickId)
+{
+  Brick* brick = this->Directory[brickId].load(std::memory_order_relaxed);
+  if (brick)
+  {
+    return brick;
+  }
+  this->OwnedBricks.emplace_back(new Brick(brickId));
+  brick = this->OwnedBricks.back().get();
+  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_relaxed);
+  this->AllocatedBrickIds[count].store(brickId, std::memory_order_relaxed);
+  // Publish the brick (initialised values) before readers can find it.
+  this->Directory[brickId].store(brick, std::memory_order_release);
+  this->NumberOfAllocatedBricks.store(count + 1, std::memory_order_release);
+  return brick;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick)
+{
+  if (this->StrokeBefore.count(brickId))
+  {
+    return;
+  }
+  BrickValues values(SamplesPerBrick, Outside);
+  if (brick)
+  {
+    for (int index = 0; index < SamplesPerBrick; ++index)
+    {
+      values[index] = brick->Values[index].load(std::memory_order_relaxed);
+    }
+  }
+  this->StrokeBefore.emplace(brickId, std::move(values));
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], double radius, Operation operation)
+{
+  const char* caller = operation == Operation::Cut ? "CutCapsule" : "RestoreCapsule";
+  if (!this->ValidateStroke(p0, p1, radius, caller))
+  {
+    return false;
+  }
+
+  // Sub-voxel index range of the capsule grown by the band.
+  const double reach = radius + this->BandWidth;
+  int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
+  int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double ras[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      ras[axis] = (corner >> axis) & 1 ? std::max(p0[axis], p1[axis]) + reach : std::min(p0[axis], p1[axis]) - reach;
+    }
+    double index[3];
+    Transform(this->RASToSubIJK, ras, index);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double clampedLow = std::max(-1.0, std::min(static_cast<double>(this->Dimensions[axis]), std::floor(index[axis])));
+      const double clampedHigh = std::max(-1.0, std::min(static_cast<double>(this->Dimensions[axis]), std::ceil(index[axis])));
+      lower[axis] = std::min(lower[axis], static_cast<int>(clampedLow));
+      upper[axis] = std::max(upper[axis], static_cast<int>(clampedHigh));
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    lower[axis] = std::max(lower[axis], 0);
+    upper[axis] = std::min(upper[axis], this->Dimensions[axis] - 1);
+    if (lower[axis] > upper[axis])
+    {
+      return true; // wholly outside the volume: nothing to do
+    }
+  }
+
+  const bool ownStroke = !this->StrokeOpen;
+  if (ownStroke)
+  {
+    this->BeginStroke();
+  }
+  const double ab[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+  const double abLength2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
+  const double inverseQuantum = 1.0 / this->Quantum;
+  const double column[3][3] = { { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] },
+    { this->SubIJKToRAS[0][1], this->SubIJKToRAS[1][1], this->SubIJKToRAS[2][1] },
+    { this->SubIJKToRAS[0][2], this->SubIJKToRAS[1][2], this->SubIJKToRAS[2][2] } };
+  int16_t newValues[SamplesPerBrick];
+  bool anyChange = false;
+
+  for (int bk = lower[2] / BrickSize; bk <= upper[2] / BrickSize; ++bk)
+  {
+    for (int bj = lower[1] / BrickSize; bj <= upper[1] / BrickSize; ++bj)
+    {
+      for (int bi = lower[0] / BrickSize; bi <= upper[0] / BrickSize; ++bi)
+      {
+        const vtkIdType brickId = (static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi;
+        Brick* brick = this->Directory[brickId].load(std::memory_order_relaxed);
+        if (!brick && operation == Operation::Restore)
+        {
+          continue; // nothing removed here, nothing to put back
+        }
+        const int begin[3] = { std::max(lower[0], bi * BrickSize), std::max(lower[1], bj * BrickSize), std::max(lower[2], bk * BrickSize) };
+        const int end[3] = { std::min(upper[0], bi * BrickSize + BrickSize - 1), std::min(upper[1], bj * BrickSize + BrickSize - 1),
+          std::min(upper[2], bk * BrickSize + BrickSize - 1) };
+        bool brickChanges = false;
+        for (int index = 0; index < SamplesPerBrick; ++index)
+        {
+          newValues[index] = brick ? brick->Values[index].load(std::memory_order_relaxed) : Outside;
+        }
+        for (int k = begin[2]; k <= end[2]; ++k)
+        {
+          for (int j = begin[1]; j <= end[1]; ++j)
+          {
+            const double index0[3] = { static_cast<double>(begin[0]), static_cast<double>(j), static_cast<double>(k) };
+            double ras[3];
+            Transform(this->SubIJKToRAS, index0, ras);
+            int local = ((k - bk * BrickSize) * BrickSize + (j - bj * BrickSize)) * BrickSize + (begin[0] - bi * BrickSize);
+            for (int i = begin[0]; i <= end[0]; ++i, ++local)
+            {
+              const double toolDistance = DistanceToSegment(ras, p0, ab, abLength2) - radius;
+              ras[0] += column[0][0];
+              ras[1] += column[0][1];
+              ras[2] += column[0][2];
+              if (operation == Operation::Cut)
+              {
+                if (toolDistance >= this->BandWidth)
+                {
+                  continue;
+                }
+                const int16_t sample = static_cast<int16_t>(std::max<double>(Inside, std::round(toolDistance * inverseQuantum)));
+                if (sample < newValues[local])
+                {
+                  newValues[local] = sample;
+                  brickChanges = true;
+                }
+              }
+              else
+              {
+                if (toolDistance >= this->BandWidth)
+                {
+                  continue; // far outside the tool: max(field, -distance) keeps the field
+                }
+                // Subtracting the tool from the removed region: max(field, -tool distance).
+                const int16_t sample =
+                  static_cast<int16_t>(std::min<double>(Outside, std::max<double>(Inside, std::round(-toolDistance * inverseQuantum))));
+                if (sample > newValues[local])
+                {
+                  newValues[local] = sample;
+                  brickChanges = true;
+                }
+              }
+            }
+          }
+        }
+        if (!brickChanges)
+        {
+          continue;
+        }
+        this->RememberBrickBeforeChange(brickId, brick);
+        if (!brick)
+        {
+          brick = this->GetOrCreateBrick(brickId);
+        }
+        // Seqlock write: readers that overlap it see an odd or changed sequence and retry.
+        const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
+        brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
+        std::atomic_thread_fence(std::memory_order_release);
+        for (int index = 0; index < SamplesPerBrick; ++index)
+        {
+          brick->Values[index].store(newValues[index], std::memory_order_relaxed);
+        }
+        brick->Stamp.store(this->StampCounter.fetch_add(1, std::memory_order_acq_rel) + 1, std::memory_order_relaxed);
+        brick->Sequence.store(sequence + 2, std::memory_order_release);
+        anyChange = true;
+      }
+    }
+  }
+  if (ownStroke)
+  {
+    this->EndStroke();
+  }
+  if (anyChange)
+  {
+    this->Modified();
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::BeginStroke()
+{
+  if (this->StrokeOpen)
+  {
+    return;
+  }
+  this->StrokeOpen = true;
+  this->StrokeBefore.clear();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::EndStroke()
+{
+  if (!this->StrokeOpen)
+  {
+    return;
+  }
+  this->StrokeOpen = false;
+  if (this->StrokeBefore.empty())
+  {
+    return;
+  }
+  UndoStep step;
+  for (auto& entry : this->StrokeBefore)
+  {
+    const Brick* brick = this->Directory[entry.first].load(std::memory_order_relaxed);
+    BrickValues after(SamplesPerBrick, Outside);
+    for (int index = 0; brick && index < SamplesPerBrick; ++index)
+    {
+      after[index] = brick->Values[index].load(std::memory_order_relaxed);
+    }
+    step.Before.emplace_back(entry.first, std::move(entry.second));
+    step.After.emplace_back(entry.first, std::move(after));
+  }
+  this->StrokeBefore.clear();
+  this->RedoStack.clear();
+  this->PushUndoStep(std::move(step));
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::PushUndoStep(UndoStep&& step)
+{
+  const size_t stepSize = step.MemorySize();
+  if (stepSize > this->UndoMemoryBudget)
+  {
+    vtkErrorMacro("EndStroke: this stroke changed " << stepSize / 1024 << " KiB of the cut field, more than the undo budget of "
+                                                    << this->UndoMemoryBudget / 1024 << " KiB; it cannot be undone, and older steps are dropped");
+    this->UndoStack.clear();
+    this->UndoMemorySize = 0;
+    return;
+  }
+  int dropped = 0;
+  while (!this->UndoStack.empty() && this->UndoMemorySize + stepSize > this->UndoMemoryBudget)
+  {
+    this->UndoMemorySize -= this->UndoStack.front().MemorySize();
+    this->UndoStack.erase(this->UndoStack.begin());
+    ++dropped;
+  }
+  if (dropped > 0)
+  {
+    vtkWarningMacro("EndStroke: the undo history reached its budget of " << this->UndoMemoryBudget / 1024 << " KiB; the oldest " << dropped
+                                                                         << " step(s) can no longer be undone");
+  }
+  this->UndoMemorySize += stepSize;
+  this->UndoStack.push_back(std::move(step));
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::WriteBricks(const std::vector<std::pair<vtkIdType, BrickValues>>& bricks)
+{
+  for (const auto& entry : bricks)
+  {
+    Brick* brick = this->GetOrCreateBrick(entry.first);
+    const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
+    brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    for (int index = 0; index < SamplesPerBrick; ++index)
+    {
+      brick->Values[index].store(entry.second[index], std::memory_order_relaxed);
+    }
+    brick->Stamp.store(this->StampCounter.fetch_add(1, std::memory_order_acq_rel) + 1, std::memory_order_relaxed);
+    brick->Sequence.store(sequence + 2, std::memory_order_release);
+  }
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::Undo()
+{
+  this->EndStroke();
+  if (this->UndoStack.empty())
+  {
+    vtkErrorMacro("Undo: there is no stroke to undo");
+    return false;
+  }
+  UndoStep step = std::move(this->UndoStack.back());
+  this->UndoStack.pop_back();
+  this->UndoMemorySize -= step.MemorySize();
+  this->WriteBricks(step.Before);
+  this->RedoStack.push_back(std::move(step));
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::Redo()
+{
+  this->EndStroke();
+  if (this->RedoStack.empty())
+  {
+    vtkErrorMacro("Redo: there is no stroke to redo");
+    return false;
+  }
+  UndoStep step = std::move(this->RedoStack.back());
+  this->RedoStack.pop_back();
+  this->WriteBricks(step.After);
+  this->UndoMemorySize += step.MemorySize();
+  this->UndoStack.push_back(std::move(step));
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int16_t vtkVolumeCutField::ReadSample(int i, int j, int k) const
+{
+  if (!this->Directory || i < 0 || j < 0 || k < 0 || i >= this->Dimensions[0] || j >= this->Dimensions[1] || k >= this->Dimensions[2])
+  {
+    return Outside;
+  }
+  const vtkIdType brickId =
+    (static_cast<vtkIdType>(k / BrickSize) * this->BrickDimensions[1] + j / BrickSize) * this->BrickDimensions[0] + i / BrickSize;
+  const Brick* brick = this->Directory[brickId].load(std::memory_order_acquire);
+  if (!brick)
+  {
+    return Outside;
+  }
+  const int local = ((k % BrickSize) * BrickSize + (j % BrickSize)) * BrickSize + (i % BrickSize);
+  return brick->Values[local].load(std::memory_order_relaxed);
+}
+
+//------------------------------------------------------------------------------
+vtkTypeUInt64 vtkVolumeCutField::CopyBrick(vtkIdType brickId, short* values) const
+{
+  const vtkIdType total = static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2];
+  if (!values || !this->Directory || brickId < 0 || brickId >= total)
+  {
+    vtkErrorMacro("CopyBrick: no brick " << brickId);
+    return 0;
+  }
+  const Brick* brick = this->Directory[brickId].load(std::memory_order_acquire);
+  if (!brick)
+  {
+    std::fill(values, values + SamplesPerBrick, Outside);
+    return 0;
+  }
+  for (;;)
+  {
+    const uint32_t before = brick->Sequence.load(std::memory_order_acquire);
+    if (before & 1u)
+    {
+      continue; // a write is under way
+    }
+    for (int index = 0; index < SamplesPerBrick; ++index)
+    {
+      values[index] = brick->Values[index].load(std::memory_order_relaxed);
+    }
+    const vtkTypeUInt64 stamp = brick->Stamp.load(std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (brick->Sequence.load(std::memory_order_relaxed) == before)
+    {
+      return stamp;
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::InterpolateAtIndex(const double index[3]) const
+{
+  const int i0 = static_cast<int>(std::floor(index[0]));
+  const int j0 = static_cast<int>(std::floor(index[1]));
+  const int k0 = static_cast<int>(std::floor(index[2]));
+  const double f[3] = { index[0] - i0, index[1] - j0, index[2] - k0 };
+  double value = 0.0;
+  double secondDifference[3] = { 0.0, 0.0, 0.0 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const int c[3] = { i0 + (corner & 1), j0 + ((corner >> 1) & 1), k0 + ((corner >> 2) & 1) };
+    const double weight =
+      ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
+    if (weight == 0.0)
+    {
+      continue;
+    }
+    const double center = this->ReadSample(c[0], c[1], c[2]);
+    value += weight * center;
+    if (center == Outside || center == Inside)
+    {
+      continue; // clamped: no curvature information
+    }
+    const double neighbors[3][2] = { { double(this->ReadSample(c[0] - 1, c[1], c[2])), double(this->ReadSample(c[0] + 1, c[1], c[2])) },
+      { double(this->ReadSample(c[0], c[1] - 1, c[2])), double(this->ReadSample(c[0], c[1] + 1, c[2])) },
+      { double(this->ReadSample(c[0], c[1], c[2] - 1)), double(this->ReadSample(c[0], c[1], c[2] + 1)) } };
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      if (neighbors[axis][0] != Outside && neighbors[axis][1] != Outside && neighbors[axis][0] != Inside && neighbors[axis][1] != Inside)
+      {
+        secondDifference[axis] += weight * (neighbors[axis][0] - 2.0 * center + neighbors[axis][1]);
+      }
+    }
+  }
+  // Linear interpolation of a curved distance field is biased by half the
+  // second derivative times t(1-t) along each axis (h^2/(6R) on average for a
+  // sphere of radius R); subtracting that estimate makes the reconstructed
+  // surface third-order accurate.
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    value -= 0.5 * f[axis] * (1.0 - f[axis]) * secondDifference[axis];
+  }
+  return value * this->Quantum;
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::GetSignedDistance(const double ras[3]) const
+{
+  if (!this->Directory || !ras || !IsFinite(ras))
+  {
+    return this->BandWidth;
+  }
+  double index[3];
+  Transform(this->RASToSubIJK, ras, index);
+  return this->InterpolateAtIndex(index);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::GetRemovedFraction(int i, int j, int k) const
+{
+  const int16_t sample = this->ReadSample(i, j, k);
+  const double distance = sample * this->Quantum;
+  // No part of the surface is nearer the sample than its distance: a cell
+  // whose half diagonal is shorter lies wholly on one side.
+  if (std::abs(distance) >= this->HalfDiagonal)
+  {
+    return distance < 0.0 ? 1.0 : 0.0;
+  }
+  // Cut cells: average, over n^3 points of the cell, the partial-volume ramp
+  // of the reconstructed distance across a sub-cell's extent along the
+  // surface normal.
+  const double gradientIndex[3] = { 0.5 * (this->ReadSample(i + 1, j, k) - this->ReadSample(i - 1, j, k)),
+    0.5 * (this->ReadSample(i, j + 1, k) - this->ReadSample(i, j - 1, k)), 0.5 * (this->ReadSample(i, j, k + 1) - this->ReadSample(i, j, k - 1)) };
+  double gradient[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    gradient[axis] =
+      this->RASToSubIJK[0][axis] * gradientIndex[0] + this->RASToSubIJK[1][axis] * gradientIndex[1] + this->RASToSubIJK[2][axis] * gradientIndex[2];
+  }
+  const double norm = vtkMath::Norm(gradient);
+  double width = 0.0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    width += norm > 0.0
+      ? std::abs(this->SubIJKToRAS[0][axis] * gradient[0] + this->SubIJKToRAS[1][axis] * gradient[1] + this->SubIJKToRAS[2][axis] * gradient[2]) / norm
+      : 0.0;
+  }
+  constexpr int n = 4;
+  const double subWidth = std::max(width / n, 1e-12);
+  double fraction = 0.0;
+  for (int c = 0; c < n; ++c)
+  {
+    for (int b = 0; b < n; ++b)
+    {
+      for (int a = 0; a < n; ++a)
+      {
+        const double index[3] = { i - 0.5 + (a + 0.5) / n, j - 0.5 + (b + 0.5) / n, k - 0.5 + (c + 0.5) / n };
+        fraction += std::min(1.0, std::max(0.0, 0.5 - this->InterpolateAtIndex(index) / subWidth));
+      }
+    }
+  }
+  return fraction / (n * n * n);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::ComputeRemovedVolume() const
+{
+  if (!this->Directory)
+  {
+    return 0.0;
+  }
+  double removed = 0.0;
+  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    const int bi = static_cast<int>(brickId % this->BrickDimensions[0]);
+    const int bj = static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]);
+    const int bk = static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1]));
+    for (int k = bk * BrickSize; k < std::min((bk + 1) * BrickSize, this->Dimensions[2]); ++k)
+    {
+      for (int j = bj * BrickSize; j < std::min((bj + 1) * BrickSize, this->Dimensions[1]); ++j)
+      {
+        for (int i = bi * BrickSize; i < std::min((bi + 1) * BrickSize, this->Dimensions[0]); ++i)
+        {
+          removed += this->GetRemovedFraction(i, j, k);
+        }
+      }
+    }
+  }
+  const double subVoxelVolume = std::abs(vtkMatrix4x4::Determinant(&this->SubIJKToRAS[0][0]));
+  return removed * subVoxelVolume;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ExportRemovedFraction(vtkImageData* anatomyFraction) const
+{
+  if (!anatomyFraction)
+  {
+    vtkErrorMacro("ExportRemovedFraction: no output image");
+    return;
+  }
+  const int f = std::max(this->SubVoxelFactor, 1);
+  const int dims[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
+  anatomyFraction->SetOrigin(0.0, 0.0, 0.0);
+  anatomyFraction->SetSpacing(1.0, 1.0, 1.0);
+  anatomyFraction->SetDimensions(std::max(dims[0], 1), std::max(dims[1], 1), std::max(dims[2], 1));
+  anatomyFraction->AllocateScalars(VTK_FLOAT, 1);
+  vtkFloatArray* scalars = vtkFloatArray::SafeDownCast(anatomyFraction->GetPointData()->GetScalars());
+  scalars->SetName("RemovedFraction");
+  scalars->FillValue(0.0f);
+  if (!this->Directory)
+  {
+    return;
+  }
+  float* fractions = scalars->GetPointer(0);
+  const double perSubVoxel = 1.0 / (f * f * f);
+  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    const int bi = static_cast<int>(brickId % this->BrickDimensions[0]);
+    const int bj = static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]);
+    const int bk = static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1]));
+    for (int k = bk * BrickSize; k < std::min((bk + 1) * BrickSize, this->Dimensions[2]); ++k)
+    {
+      for (int j = bj * BrickSize; j < std::min((bj + 1) * BrickSize, this->Dimensions[1]); ++j)
+      {
+        for (int i = bi * BrickSize; i < std::min((bi + 1) * BrickSize, this->Dimensions[0]); ++i)
+        {
+          const double fraction = this->GetRemovedFraction(i, j, k);
+          if (fraction > 0.0)
+          {
+            fractions[(static_cast<vtkIdType>(k / f) * dims[1] + j / f) * dims[0] + i / f] += static_cast<float>(fraction * perSubVoxel);
+          }
+        }
+      }
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::GetBricksModifiedSince(vtkTypeUInt64 stamp, vtkIdList* brickIds) const
+{
+  if (!brickIds)
+  {
+    return;
+  }
+  brickIds->Reset();
+  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    const Brick* brick = this->Directory[brickId].load(std::memory_order_acquire);
+    if (brick && brick->Stamp.load(std::memory_order_relaxed) > stamp)
+    {
+      brickIds->InsertNextId(brickId);
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutField::GetBrickMemorySize() const
+{
+  const vtkIdType total = static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2];
+  return static_cast<size_t>(this->GetNumberOfAllocatedBricks()) * sizeof(Brick)
+    + static_cast<size_t>(total) * (sizeof(std::atomic<Brick*>) + sizeof(std::atomic<vtkIdType>));
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutField::GetDenseMemorySize() const
+{
+  return static_cast<size_t>(this->Dimensions[0]) * this->Dimensions[1] * this->Dimensions[2] * sizeof(int16_t);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " " << this->Dimensions[2] << "\n";
+  os << indent << "SubVoxelFactor: " << this->SubVoxelFactor << "\n";
+  os << indent << "BandWidth: " << this->BandWidth << "\n";
+  os << indent << "MaximumStrokeLength: " << this->MaximumStrokeLength << "\n";
+  os << indent << "NumberOfAllocatedBricks: " << this->GetNumberOfAllocatedBricks() << "\n";
+  os << indent << "UndoSteps: " << this->UndoStack.size() << " (" << this->UndoMemorySize / 1024 << " KiB of " << this->UndoMemoryBudget / 1024
+     << " KiB)\n";
+}

@@ -1,0 +1,267 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+/**
+ * @class   vtkVolumeCutField
+ * @brief   The removed region of a cutting session, at sub-voxel resolution.
+ *
+ * Multivolume scheme of Pflesser et al. (2002): the anatomy is never changed;
+ * what the tools remove lives in this separate field, aligned with the
+ * anatomy's voxel grid (any spacing, any IJK-to-RAS orientation) and refined
+ * by a sub-voxel factor of 1, 2 or 4 along each axis.
+ *
+ * Representation: a narrow-band signed distance to the boundary of the
+ * removed region, in millimetres, negative inside (removed), sampled at
+ * sub-voxel centres and clamped to +-BandWidth. A cut is the union of the
+ * removed region with the tool's swept volume, which on distances is a
+ * minimum: it resamples the existing cut and the new tool together, as
+ * progressive cutting requires, and it is exact, associative and idempotent,
+ * so many small overlapping strokes give the same field as one large stroke,
+ * without erosion or drift. Restoring material (seed 004's adding) is the
+ * maximum with the negated tool distance. The partial-volume (filtered)
+ * removed fraction of any sample follows from its distance.
+ *
+ * Storage is sparse: 8x8x8 bricks, allocated only where a tool came within the
+ * band. Each brick carries a modification stamp, so a renderer uploads and
+ * re-renders only what changed since the stamp it last saw.
+ *
+ * Threads: one writer (the haptic or interaction thread) calls the cut,
+ * restore and undo methods; any number of readers may call the query methods
+ * at the same time. The writer never waits: bricks are published once and
+ * never freed while the field lives, and each brick has a sequence counter
+ * that readers check to retry a read that overlapped a write.
+ */
+
+#ifndef vtkVolumeCutField_h
+#define vtkVolumeCutField_h
+
+#include "vtkObject.h"
+#include "vtkType.h" // For vtkTypeUInt64
+#include "vtkVolumeCuttingCoreExport.h" // For export macro
+
+#include <atomic>  // For the brick directory
+#include <cstdint> // For int16_t
+#include <map>     // For the open stroke
+#include <memory>  // For std::unique_ptr
+#include <vector>  // For the brick directory
+
+class vtkIdList;
+class vtkImageData;
+class vtkMatrix4x4;
+
+class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutField : public vtkObject
+{
+public:
+  static vtkVolumeCutField* New();
+  vtkTypeMacro(vtkVolumeCutField, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Edge length of a brick, in sub-voxels.
+  static constexpr int BrickSize = 8;
+
+  /**
+   * Align the field with an anatomy volume of the given dimensions and
+   * IJK-to-RAS matrix, at a sub-voxel factor of 1, 2 or 4. Everything cut so
+   * far and the undo history are discarded. Returns false and logs an error,
+   * leaving the field as it was, for non-positive dimensions, a factor other
+   * than 1, 2 or 4, a matrix that is not finite or not invertible, or more
+   * than 2^31 bricks.
+   */
+  bool Initialize(const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int subVoxelFactor);
+
+  ///@{
+  /**
+   * Geometry of the sub-voxel grid (valid after Initialize).
+   */
+  vtkGetVector3Macro(Dimensions, int);
+  vtkGetMacro(SubVoxelFactor, int);
+  void GetSubVoxelIJKToRAS(vtkMatrix4x4* matrix) const;
+  /// Sub-voxel edge lengths in mm along the three grid axes.
+  void GetSubVoxelSpacing(double spacing[3]) const;
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the half width (mm) of the band in which distances are stored.
+   * It must cover the diagonal of a sub-voxel and its neighbours; Initialize sets it to 3.5 times
+   * the largest sub-voxel spacing. Farther samples are clamped.
+   */
+  vtkGetMacro(BandWidth, double);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the longest stroke (mm) accepted as one continuous sweep. A longer
+   * jump between two poses (a tracking glitch, a device reconnected
+   * elsewhere) is rejected with an error instead of carving a channel through
+   * the anatomy. Default is 50 mm.
+   */
+  vtkSetClampMacro(MaximumStrokeLength, double, 0.0, 1.0e6);
+  vtkGetMacro(MaximumStrokeLength, double);
+  ///@}
+
+  /**
+   * Remove the volume swept by a sphere of the given radius (mm) moving from
+   * p0 to p1 (RAS, mm): a capsule, or a sphere when p0 equals p1. This is the
+   * continuous sweep of a spherical burr between two poses, so fast strokes
+   * leave no gaps. Returns false and logs an error, changing nothing, for a
+   * non-finite pose, a radius that is not positive, or a stroke longer than
+   * MaximumStrokeLength. A tool wholly outside the volume changes nothing and
+   * returns true. Each successful call is one undo step.
+   */
+  bool CutCapsule(const double p0[3], const double p1[3], double radius);
+
+  /**
+   * Put back removed material inside the capsule (restore brush): the
+   * removed region loses the tool's swept volume. Same validation as
+   * CutCapsule; one undo step.
+   */
+  bool RestoreCapsule(const double p0[3], const double p1[3], double radius);
+
+  ///@{
+  /**
+   * Group the cuts and restores between BeginStroke and EndStroke into one
+   * undo step: a user's stroke is many device poses (a thousand a second from
+   * a haptic device), undone together. Calls outside a stroke are one step
+   * each. EndStroke without BeginStroke does nothing.
+   */
+  void BeginStroke();
+  void EndStroke();
+  bool IsStrokeOpen() const { return this->StrokeOpen; }
+  ///@}
+
+  ///@{
+  /**
+   * Undo or redo one stroke (an open stroke is ended first). Return false (and log an error) when there is
+   * nothing to undo or redo.
+   */
+  bool Undo();
+  bool Redo();
+  int GetNumberOfUndoSteps() const;
+  int GetNumberOfRedoSteps() const;
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the memory (bytes) the undo history may use. When a stroke would
+   * exceed it, the oldest steps are dropped and a warning says how many; a
+   * single stroke larger than the budget cannot be undone (error). Default is
+   * 256 MiB. GetUndoMemorySize reports what the history uses now.
+   */
+  vtkSetMacro(UndoMemoryBudget, size_t);
+  vtkGetMacro(UndoMemoryBudget, size_t);
+  size_t GetUndoMemorySize() const { return this->UndoMemorySize; }
+  ///@}
+
+  /**
+   * Signed distance (mm) to the boundary of the removed region at a RAS
+   * point, trilinearly interpolated with a curvature correction from the
+   * samples' second differences; negative where removed. Points outside
+   * the band or the volume return +BandWidth. Safe to call while a writer cuts.
+   */
+  double GetSignedDistance(const double ras[3]) const;
+
+  /**
+   * Removed fraction (0..1) of the sub-voxel (i, j, k): the partial-volume
+   * (filtered) value of the removed region. Cells the surface crosses are
+   * integrated over 4^3 points of the reconstructed distance, each with a
+   * ramp as wide as a sub-cell's extent along the surface normal.
+   */
+  double GetRemovedFraction(int i, int j, int k) const;
+
+  /**
+   * Copy one brick's samples (BrickSize^3 values, x fastest; the distance in
+   * mm is value * GetQuantum()) consistently even while the writer changes
+   * it, and return the brick's stamp (0 for a brick never written, whose
+   * samples are all +BandWidth). For renderers uploading changed bricks.
+   */
+  vtkTypeUInt64 CopyBrick(vtkIdType brickId, short* values) const;
+
+  /// Distance (mm) of one unit of the stored samples.
+  vtkGetMacro(Quantum, double);
+
+  /// Total removed volume (mm^3): the sum of removed fractions.
+  double ComputeRemovedVolume() const;
+
+  /**
+   * Fraction removed (0..1) of each anatomy voxel, as a float image with the
+   * anatomy's dimensions and IJK geometry (origin 0, spacing 1: the anatomy
+   * node gives IJK-to-RAS), the mean of its sub-voxels' removed fractions.
+   */
+  void ExportRemovedFraction(vtkImageData* anatomyFraction) const;
+
+  ///@{
+  /**
+   * Modification stamps. Every change to a brick gives it a new stamp, larger
+   * than any before. A renderer keeps the current stamp and later asks which
+   * bricks changed since then.
+   */
+  vtkTypeUInt64 GetCurrentStamp() const { return this->StampCounter.load(std::memory_order_acquire); }
+  void GetBricksModifiedSince(vtkTypeUInt64 stamp, vtkIdList* brickIds) const;
+  vtkGetVector3Macro(BrickDimensions, int);
+  ///@}
+
+  ///@{
+  /**
+   * Memory in use by allocated bricks (bytes), their number, and the memory
+   * a dense field of the same resolution would need.
+   */
+  vtkIdType GetNumberOfAllocatedBricks() const { return this->NumberOfAllocatedBricks.load(std::memory_order_acquire); }
+  size_t GetBrickMemorySize() const;
+  size_t GetDenseMemorySize() const;
+  ///@}
+
+protected:
+  vtkVolumeCutField();
+  ~vtkVolumeCutField() override;
+
+  struct Brick;
+  struct UndoStep;
+  enum class Operation
+  {
+    Cut,
+    Restore
+  };
+
+  using BrickValues = std::vector<int16_t>;
+
+  bool ApplyCapsule(const double p0[3], const double p1[3], double radius, Operation operation);
+  bool ValidateStroke(const double p0[3], const double p1[3], double radius, const char* caller) const;
+  Brick* GetOrCreateBrick(vtkIdType brickId);
+  void RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick);
+  void PushUndoStep(UndoStep&& step);
+  void WriteBricks(const std::vector<std::pair<vtkIdType, BrickValues>>& bricks);
+  int16_t ReadSample(int i, int j, int k) const;
+  double InterpolateAtIndex(const double index[3]) const;
+  void Reset();
+
+  int Dimensions[3] = { 0, 0, 0 };
+  int BrickDimensions[3] = { 0, 0, 0 };
+  int SubVoxelFactor = 0;
+  double BandWidth = 1.0;
+  double Quantum = 1.0 / 32767.0;
+  double HalfDiagonal = 0.5;
+  double MaximumStrokeLength = 50.0;
+  double SubIJKToRAS[4][4];
+  double RASToSubIJK[4][4];
+  size_t UndoMemoryBudget = 256u << 20;
+  size_t UndoMemorySize = 0;
+
+  std::unique_ptr<std::atomic<Brick*>[]> Directory;
+  // Allocated brick IDs in allocation order; readers see the first
+  // NumberOfAllocatedBricks entries.
+  std::unique_ptr<std::atomic<vtkIdType>[]> AllocatedBrickIds;
+  std::atomic<vtkIdType> NumberOfAllocatedBricks{ 0 };
+  std::vector<std::unique_ptr<Brick>> OwnedBricks;
+  bool StrokeOpen = false;
+  // Bricks touched by the open stroke: their values before it began.
+  std::map<vtkIdType, BrickValues> StrokeBefore;
+  std::atomic<vtkTypeUInt64> StampCounter{ 0 };
+  std::vector<UndoStep> UndoStack;
+  std::vector<UndoStep> RedoStack;
+
+private:
+  vtkVolumeCutField(const vtkVolumeCutField&) = delete;
+  void operator=(const vtkVolumeCutField&) = delete;
+};
+
+#endif
