@@ -252,6 +252,8 @@ protected:
   std::unique_ptr<std::atomic<vtkIdType>[]> AllocatedBrickIds;
   std::atomic<vtkIdType> NumberOfAllocatedBricks{ 0 };
   std::vector<std::unique_ptr<Brick>> OwnedBricks;
+  // Writer's scratch: quantised tool distances of the rows of one line of bricks.
+  std::vector<int16_t> RowScratch;
   bool StrokeOpen = false;
   // Bricks touched by the open stroke: their values before it began.
   std::map<vtkIdType, BrickValues> StrokeBefore;
