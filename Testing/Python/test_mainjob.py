@@ -60,4 +60,6 @@ def test_main_job_on_the_phantom(tmp_path):
 def test_main_job_on_the_real_head_ct(tmp_path):
     summary = mainjob.run(False, tmp_path, size=(320, 240))
     assert summary["bone_segments"] == ["CorticalBone", "TrabecularBone"]
+    removed = summary["drilling"]["removed_volume_per_segment_mm3"]
+    assert removed["CorticalBone"] > 100.0  # the mastoid cortex is opened
     check_outputs(summary, tmp_path)

@@ -13,6 +13,7 @@
 // VolumeCutting includes
 #include "vtkImageBoneSegmentation.h"
 #include "vtkMRMLVolumeCutNode.h"
+#include "vtkVolumeCutField.h"
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
@@ -33,9 +34,11 @@
 
 // VTK includes
 #include <vtkCommand.h>
+#include <vtkFloatArray.h>
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
+#include <vtkIntArray.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 
@@ -303,4 +306,243 @@ bool vtkSlicerVolumeCuttingLogic::CheckInputs(vtkMRMLVolumeCutNode* cutNode, vtk
     }
   }
   return valid;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::SetMRMLSceneInternal(vtkMRMLScene* newScene)
+{
+  vtkNew<vtkIntArray> events;
+  events->InsertNextValue(vtkMRMLScene::NodeRemovedEvent);
+  events->InsertNextValue(vtkMRMLScene::EndCloseEvent);
+  this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
+  this->CutFields.clear();
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
+{
+  if (node && node->GetID())
+  {
+    this->CutFields.erase(node->GetID());
+  }
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::OnMRMLSceneEndClose()
+{
+  this->CutFields.clear();
+}
+
+//----------------------------------------------------------------------------
+vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode* cutNode)
+{
+  if (!cutNode || !cutNode->GetID())
+  {
+    vtkErrorMacro("GetCutField: no volume-cut node in a scene");
+    return nullptr;
+  }
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkImageData* image = anatomy ? anatomy->GetImageData() : nullptr;
+  if (!image || image->GetNumberOfPoints() == 0)
+  {
+    vtkErrorMacro("GetCutField: the volume-cut node '" << (cutNode->GetName() ? cutNode->GetName() : "") << "' has no anatomy volume with voxels");
+    return nullptr;
+  }
+  int anatomyDimensions[3];
+  image->GetDimensions(anatomyDimensions);
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+
+  vtkSmartPointer<vtkVolumeCutField>& field = this->CutFields[cutNode->GetID()];
+  bool matches = field != nullptr && field->GetSubVoxelFactor() == cutNode->GetSubVoxelFactor();
+  if (matches)
+  {
+    vtkNew<vtkMatrix4x4> fieldToRas;
+    field->GetSubVoxelIJKToRAS(fieldToRas);
+    const int factor = field->GetSubVoxelFactor();
+    for (int axis = 0; axis < 3 && matches; ++axis)
+    {
+      matches = field->GetDimensions()[axis] == anatomyDimensions[axis] * factor;
+      for (int row = 0; row < 3 && matches; ++row)
+      {
+        matches = std::abs(fieldToRas->GetElement(row, axis) * factor - ijkToRas->GetElement(row, axis)) < 1e-9;
+      }
+    }
+    // Sub-voxel 0 sits (0.5 / f - 0.5) anatomy voxels from anatomy voxel 0.
+    for (int row = 0; row < 3 && matches; ++row)
+    {
+      double expected = ijkToRas->GetElement(row, 3);
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        expected += ijkToRas->GetElement(row, axis) * (0.5 / factor - 0.5);
+      }
+      matches = std::abs(fieldToRas->GetElement(row, 3) - expected) < 1e-9;
+    }
+  }
+  if (!matches)
+  {
+    vtkNew<vtkVolumeCutField> newField;
+    if (!newField->Initialize(anatomyDimensions, ijkToRas, cutNode->GetSubVoxelFactor()))
+    {
+      this->CutFields.erase(cutNode->GetID());
+      return nullptr;
+    }
+    if (field)
+    {
+      vtkWarningMacro("GetCutField: the anatomy grid or sub-voxel factor of '" << (cutNode->GetName() ? cutNode->GetName() : "")
+                                                                                << "' changed; its cut starts anew");
+    }
+    this->CutFields[cutNode->GetID()] = newField;
+    return newField;
+  }
+  return field;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::BeginStroke(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field)
+  {
+    return false;
+  }
+  field->BeginStroke();
+  return true;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->CutCapsule(p0, p1, radius);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->RestoreCapsule(p0, p1, radius);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field)
+  {
+    return false;
+  }
+  field->EndStroke();
+  return true;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::UndoStroke(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->Undo();
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::RedoStroke(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->Redo();
+}
+
+//----------------------------------------------------------------------------
+double vtkSlicerVolumeCuttingLogic::GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field ? field->ComputeRemovedVolume() : 0.0;
+}
+
+//----------------------------------------------------------------------------
+double vtkSlicerVolumeCuttingLogic::GetRemovedVolumeInSegment(vtkMRMLVolumeCutNode* cutNode, const char* segmentId)
+{
+  vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
+  if (!segmentationNode || !segmentId || !segmentationNode->GetSegmentation()->GetSegment(segmentId))
+  {
+    vtkErrorMacro("GetRemovedVolumeInSegment: no segment '" << (segmentId ? segmentId : "") << "' in the cut node's segmentation");
+    return -1.0;
+  }
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field)
+  {
+    return -1.0;
+  }
+  vtkNew<vtkImageData> fraction;
+  field->ExportRemovedFraction(fraction);
+
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  GetVolumeGeometry(anatomy, anatomyGeometry);
+  vtkNew<vtkOrientedImageData> segmentMask;
+  if (!segmentationNode->GetBinaryLabelmapRepresentation(segmentId, segmentMask))
+  {
+    vtkErrorMacro("GetRemovedVolumeInSegment: segment '" << segmentId << "' has no binary labelmap");
+    return -1.0;
+  }
+  vtkNew<vtkOrientedImageData> mask;
+  if (!vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
+  {
+    vtkErrorMacro("GetRemovedVolumeInSegment: segment '" << segmentId << "' could not be resampled to the anatomy's grid");
+    return -1.0;
+  }
+  int extent[6];
+  mask->GetExtent(extent);
+  const int* dims = fraction->GetDimensions();
+  const float* fractions = static_cast<const float*>(fraction->GetScalarPointer());
+  double removed = 0.0;
+  for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+  {
+    for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+    {
+      for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
+      {
+        if (mask->GetScalarComponentAsDouble(i, j, k, 0) > 0.0)
+        {
+          removed += fractions[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i];
+        }
+      }
+    }
+  }
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  return removed * std::abs(ijkToRas->Determinant());
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLSegmentationNode* vtkSlicerVolumeCuttingLogic::ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field || !this->GetMRMLScene())
+  {
+    return nullptr;
+  }
+  vtkNew<vtkImageData> fraction;
+  field->ExportRemovedFraction(fraction);
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  vtkNew<vtkOrientedImageData> mask;
+  mask->SetExtent(fraction->GetExtent());
+  mask->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  mask->SetImageToWorldMatrix(ijkToRas);
+  const float* fractions = static_cast<const float*>(fraction->GetScalarPointer());
+  unsigned char* voxels = static_cast<unsigned char*>(mask->GetScalarPointer());
+  for (vtkIdType n = 0; n < fraction->GetNumberOfPoints(); ++n)
+  {
+    voxels[n] = fractions[n] >= 0.5f ? 1 : 0;
+  }
+  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed";
+  vtkMRMLSegmentationNode* segmentationNode = vtkMRMLSegmentationNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLSegmentationNode", nodeName));
+  segmentationNode->CreateDefaultDisplayNodes();
+  segmentationNode->SetReferenceImageGeometryParameterFromVolumeNode(anatomy);
+  vtkNew<vtkSegment> segment;
+  segment->SetName("Removed");
+  segment->SetColor(0.85, 0.15, 0.1);
+  segment->AddRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName(), mask);
+  segmentationNode->GetSegmentation()->AddSegment(segment, "Removed");
+  return segmentationNode;
 }

@@ -15,7 +15,11 @@
 #include <vtkSlicerModuleLogic.h>
 
 // STD includes
+#include <map>
 #include <string>
+
+// VTK includes
+#include <vtkSmartPointer.h>
 
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
 
@@ -23,6 +27,7 @@ class vtkMRMLMessageCollection;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
+class vtkVolumeCutField;
 
 /// \brief Builds and checks volume-cutting sessions.
 ///
@@ -65,6 +70,41 @@ public:
   /// Returns true when there is no error.
   bool CheckInputs(vtkMRMLVolumeCutNode* cutNode, vtkMRMLMessageCollection* messages);
 
+  /// The cut field of a cut node: created on first use on the anatomy's voxel
+  /// grid at the node's sub-voxel factor, and created anew (empty) when the
+  /// anatomy's geometry or the factor changes. nullptr (and an error) when the
+  /// node has no anatomy with voxels.
+  vtkVolumeCutField* GetCutField(vtkMRMLVolumeCutNode* cutNode);
+
+  ///@{
+  /// Strokes from any source (mouse, haptic device, replay) go through here.
+  /// A stroke of a spherical burr of the given radius (mm) sweeps from p0 to
+  /// p1 (RAS, mm); BeginStroke/EndStroke group poses into one undo step.
+  /// Return false, with the reason in the log, when the stroke is refused
+  /// (bad pose or radius, no anatomy); what was cut before is kept.
+  bool BeginStroke(vtkMRMLVolumeCutNode* cutNode);
+  bool CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);
+  bool RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);
+  bool EndStroke(vtkMRMLVolumeCutNode* cutNode);
+  bool UndoStroke(vtkMRMLVolumeCutNode* cutNode);
+  bool RedoStroke(vtkMRMLVolumeCutNode* cutNode);
+  ///@}
+
+  /// Volume (mm^3) removed inside a segment: the cut field's removed fraction
+  /// of each anatomy voxel, summed over the segment's voxels (resampled to the
+  /// anatomy's grid if needed). Returns -1 and logs an error for an unknown
+  /// segment or a node without segmentation.
+  double GetRemovedVolumeInSegment(vtkMRMLVolumeCutNode* cutNode, const char* segmentId);
+
+  /// Add a segmentation holding the removed region as one segment on the
+  /// anatomy's grid: voxels at least half removed (binary labelmap). For
+  /// display and export (STL, labelmap) with Slicer's segmentation tools.
+  /// nullptr and an error if the node has no cut field.
+  vtkMRMLSegmentationNode* ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
+
+  /// Total removed volume (mm^3) of the node's cut field.
+  double GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode);
+
 protected:
   vtkSlicerVolumeCuttingLogic();
   ~vtkSlicerVolumeCuttingLogic() override;
@@ -76,6 +116,14 @@ protected:
   /// Segments need the labelmap and closed-surface representations; desktop
   /// Slicer registers their conversion rules at start-up, a bare scene does not.
   static void RegisterSegmentationConverterRules();
+
+  void OnMRMLSceneNodeRemoved(vtkMRMLNode* node) override;
+  void OnMRMLSceneEndClose() override;
+  void SetMRMLSceneInternal(vtkMRMLScene* newScene) override;
+
+  /// Cut fields by cut-node ID. The logic owns them: the node stays a
+  /// parameter holder, the field is the Slicer-independent algorithm.
+  std::map<std::string, vtkSmartPointer<vtkVolumeCutField>> CutFields;
 };
 
 #endif

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import slicer
 
-from . import headct, phantom
+from . import drilling, headct, phantom
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -31,6 +31,11 @@ from .application import HeadlessSlicer
 PHANTOM_CUTTABLE_SEGMENTS = ("MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
 PHANTOM_PROTECTED_SEGMENTS = (
     "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
+
+# Centre (y, z in RAS mm) of the right mastoid on the real head CT, read off
+# the pinned data: slice k=21, row j=108, where the air cells lie behind the
+# ear canal (the lateral cortex there is at i=67).
+HEAD_CT_RIGHT_MASTOID_YZ = (-18.6, -48.75)
 
 
 class Stopwatch:
@@ -102,8 +107,27 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
     messages = slicer.vtkMRMLMessageCollection()
     inputs_ok = logic.CheckInputs(cut_node, messages)
 
+    # Drill a cortical mastoidectomy from the patient's right.
+    if use_phantom:
+        air_cells = anatomy_segmentation.GetSegmentation().GetSegment("MastoidAirCells")
+        bounds = [0.0] * 6
+        air_cells.GetBounds(bounds)
+        target_yz = ((bounds[2] + bounds[3]) / 2.0, (bounds[4] + bounds[5]) / 2.0)
+        plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *target_yz),
+                                          surface_radius=7.0, depth=8.0, burr_radius=2.0)
+    else:
+        plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *HEAD_CT_RIGHT_MASTOID_YZ))
+    with timer.measure("drilling_s"):
+        drilled = drilling.drill(logic, cut_node, plan)
+    removed_per_segment = {
+        segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
+        for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
+    }
+    removed = logic.ExportRemovedRegionToSegmentation(cut_node, None)
+
     with timer.measure("surface_s"):
         bone.CreateClosedSurfaceRepresentation()
+        removed.CreateClosedSurfaceRepresentation()
         if anatomy_segmentation is not None:
             # Show the structures the user must see through the bone.
             anatomy_segmentation.CreateClosedSurfaceRepresentation()
@@ -111,6 +135,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
             for segment_id in anatomy_segmentation.GetSegmentation().GetSegmentIDs():
                 display.SetSegmentVisibility(segment_id, segment_id in PHANTOM_PROTECTED_SEGMENTS)
             bone.GetDisplayNode().SetOpacity3D(0.35)
+        else:
+            bone.GetDisplayNode().SetOpacity3D(0.6)
 
     view = application.create_3d_view(*size)
     lateral_camera(view, bone, None)
@@ -133,6 +159,17 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         "sub_voxel_factor": cut_node.GetSubVoxelFactor(),
         "inputs_ok": bool(inputs_ok),
         "input_messages": messages.GetAllMessagesAsString(),
+        "drilling": {
+            "plan": {
+                "entry_ras_mm": [round(float(v), 2) for v in plan.entry],
+                "surface_radius_mm": plan.surface_radius,
+                "depth_mm": plan.depth,
+                "burr_radius_mm": plan.burr_radius,
+            },
+            **drilled,
+            "removed_volume_mm3": round(logic.GetRemovedVolume(cut_node), 2),
+            "removed_volume_per_segment_mm3": removed_per_segment,
+        },
         "renderer": renderer,
         "image": str(image_path),
         "scene_bundle": str(bundle),

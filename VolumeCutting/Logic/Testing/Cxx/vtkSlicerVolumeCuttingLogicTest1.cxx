@@ -11,6 +11,7 @@
 // VolumeCutting includes
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkSlicerVolumeCuttingLogic.h"
+#include "vtkVolumeCutField.h"
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
@@ -218,11 +219,78 @@ int TestCheckInputsReportsProblems()
   CHECK_INT(scene->GetNumberOfNodes(), nodesBefore);
   return EXIT_SUCCESS;
 }
+int TestStrokesAndRemovedVolumePerSegment()
+{
+  vtkNew<vtkMRMLScene> scene;
+  vtkNew<vtkSlicerVolumeCuttingLogic> logic;
+  logic->SetMRMLScene(scene);
+  int cortical = 0;
+  int trabecular = 0;
+  vtkMRMLScalarVolumeNode* volume = AddBallVolume(scene, cortical, trabecular);
+  vtkMRMLSegmentationNode* bone = logic->CreateBoneSegmentation(volume);
+  vtkMRMLVolumeCutNode* cutNode = logic->AddVolumeCutNode(volume, bone);
+
+  // The ball's centre in RAS: voxel (12, 12, 10).
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  volume->GetIJKToRASMatrix(ijkToRas);
+  const double centerIjk[4] = { 12.0, 12.0, 10.0, 1.0 };
+  double center[4];
+  ijkToRas->MultiplyPoint(centerIjk, center);
+
+  // A 2 mm burr at the centre stays inside the trabecular ball (semi-axes 3, 3, 4.8 mm).
+  CHECK_BOOL(logic->BeginStroke(cutNode), true);
+  CHECK_BOOL(logic->CutSphereSweep(cutNode, center, center, 2.0), true);
+  CHECK_BOOL(logic->EndStroke(cutNode), true);
+  const double sphere = 4.0 / 3.0 * 3.14159265358979 * 8.0;
+  const double total = logic->GetRemovedVolume(cutNode);
+  CHECK_BOOL(std::abs(total - sphere) / sphere < 0.005, true);
+  const double inTrabecular = logic->GetRemovedVolumeInSegment(cutNode, vtkSlicerVolumeCuttingLogic::GetTrabecularBoneSegmentID());
+  const double inCortical = logic->GetRemovedVolumeInSegment(cutNode, vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID());
+  CHECK_DOUBLE_TOLERANCE(inTrabecular, total, 1e-3 * total);
+  CHECK_DOUBLE_TOLERANCE(inCortical, 0.0, 1e-9);
+
+  // A sweep out through the shell removes cortical bone too.
+  const double outsideIjk[4] = { 22.0, 12.0, 10.0, 1.0 };
+  double outside[4];
+  ijkToRas->MultiplyPoint(outsideIjk, outside);
+  CHECK_BOOL(logic->CutSphereSweep(cutNode, center, outside, 1.0), true);
+  CHECK_BOOL(logic->GetRemovedVolumeInSegment(cutNode, vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID()) > 1.0, true);
+  CHECK_BOOL(logic->GetCutField(cutNode)->GetNumberOfUndoSteps() == 2, true);
+  CHECK_BOOL(logic->UndoStroke(cutNode), true);
+  CHECK_DOUBLE_TOLERANCE(logic->GetRemovedVolume(cutNode), total, 1e-9);
+  CHECK_BOOL(logic->RedoStroke(cutNode), true);
+
+  // Refused strokes keep the cut; unknown segments are errors.
+  const double volumeBefore = logic->GetRemovedVolume(cutNode);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(logic->CutSphereSweep(cutNode, center, center, -1.0), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_DOUBLE(logic->GetRemovedVolumeInSegment(cutNode, "NoSuchSegment"), -1.0);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_DOUBLE_TOLERANCE(logic->GetRemovedVolume(cutNode), volumeBefore, 1e-12);
+
+  // Another sub-voxel factor means another grid: the field starts anew, with a warning.
+  cutNode->SetSubVoxelFactor(4);
+  TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
+  CHECK_DOUBLE_TOLERANCE(logic->GetRemovedVolume(cutNode), 0.0, 1e-12);
+  TESTING_OUTPUT_ASSERT_WARNINGS_END();
+  CHECK_INT(logic->GetCutField(cutNode)->GetSubVoxelFactor(), 4);
+
+  // Removing the node releases its field; a node without anatomy has none.
+  vtkMRMLVolumeCutNode* empty = logic->AddVolumeCutNode(nullptr, nullptr);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_NULL(logic->GetCutField(empty));
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  scene->RemoveNode(cutNode);
+  return EXIT_SUCCESS;
+}
 } // namespace
 
 int vtkSlicerVolumeCuttingLogicTest1(int, char*[])
 {
   CHECK_EXIT_SUCCESS(TestBoneSegmentationAndCutNode());
   CHECK_EXIT_SUCCESS(TestCheckInputsReportsProblems());
+  CHECK_EXIT_SUCCESS(TestStrokesAndRemovedVolumePerSegment());
   return EXIT_SUCCESS;
 }
