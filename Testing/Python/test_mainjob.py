@@ -63,3 +63,29 @@ def test_main_job_on_the_real_head_ct(tmp_path):
     removed = summary["drilling"]["removed_volume_per_segment_mm3"]
     assert removed["CorticalBone"] > 100.0  # the mastoid cortex is opened
     check_outputs(summary, tmp_path)
+
+
+def test_protected_nerve_survives_a_stroke_through_it(tmp_path):
+    """A pass aimed through the facial nerve leaves the nerve and reports the contact."""
+    from VolumeCuttingLib import phantom
+
+    application = HeadlessSlicer()
+    logic = application.volume_cutting_logic
+    generated = phantom.generate_phantom(dimensions=(96, 96, 72), spacing=(0.5, 0.5, 0.6), seed=1)
+    volume, segmentation = phantom.create_phantom_nodes(application.scene, generated)
+    cut = logic.AddVolumeCutNode(volume, segmentation)
+    cut.SetProtectedSegmentIDs(["FacialNerve"])
+    cut.SetCuttableSegmentIDs(["MastoidBone", "FacialCanalWall"])
+    nerve = generated.segment("FacialNerve")
+    # A voxel centre of the nerve (labelmap indices are k, j, i).
+    voxels = np.argwhere(generated.labelmap == nerve.label)
+    middle = generated.ijk_to_ras_points(voxels[len(voxels) // 2][::-1].astype(float)[None, :])[0].tolist()
+    assert nerve.contains(np.array([middle]))[0]
+    start = [middle[0] + 6.0, middle[1], middle[2]]
+    end = [middle[0] - 6.0, middle[1], middle[2]]
+    assert logic.CutSphereSweep(cut, start, end, 1.5)
+    assert logic.GetRemovedVolume(cut) > 10.0
+    assert logic.GetRemovedVolumeInSegment(cut, "FacialNerve") < 0.05 * nerve.volume_mm3
+    assert logic.GetCutField(cut).GetSignedDistance(middle) > 0.0
+    assert logic.GetContactSegmentID(cut) == "FacialNerve"
+    assert logic.GetCutField(cut).GetMaximumContactDepth() > 1.0

@@ -393,9 +393,85 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
                                                                                 << "' changed; its cut starts anew");
     }
     this->CutFields[cutNode->GetID()] = newField;
+    this->ProtectionSources.erase(cutNode->GetID());
+    this->UpdateProtection(cutNode, newField);
     return newField;
   }
+  this->UpdateProtection(cutNode, field);
   return field;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field)
+{
+  vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
+  const std::vector<std::string> protectedIds = cutNode->GetProtectedSegmentIDs();
+  std::ostringstream source;
+  if (segmentationNode)
+  {
+    source << segmentationNode->GetID() << "@" << segmentationNode->GetSegmentation()->GetMTime();
+  }
+  for (const std::string& id : protectedIds)
+  {
+    source << "|" << id;
+  }
+  std::string& last = this->ProtectionSources[cutNode->GetID()];
+  if (last == source.str())
+  {
+    return;
+  }
+  last = source.str();
+  if (!segmentationNode || protectedIds.empty())
+  {
+    field->SetProtectedLabels(nullptr);
+    return;
+  }
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  GetVolumeGeometry(anatomy, anatomyGeometry);
+  vtkNew<vtkImageData> labels;
+  labels->SetExtent(anatomy->GetImageData()->GetExtent());
+  labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  labels->GetPointData()->GetScalars()->FillComponent(0, 0.0);
+  unsigned char* labelVoxels = static_cast<unsigned char*>(labels->GetScalarPointer());
+  const int* dims = labels->GetDimensions();
+  for (size_t index = 0; index < protectedIds.size() && index < 255; ++index)
+  {
+    vtkNew<vtkOrientedImageData> segmentMask;
+    vtkNew<vtkOrientedImageData> mask;
+    if (!segmentationNode->GetSegmentation()->GetSegment(protectedIds[index])
+        || !segmentationNode->GetBinaryLabelmapRepresentation(protectedIds[index], segmentMask)
+        || !vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
+    {
+      vtkWarningMacro("UpdateProtection: protected segment '" << protectedIds[index] << "' has no labelmap on the anatomy grid; it is not protected");
+      continue;
+    }
+    int extent[6];
+    mask->GetExtent(extent);
+    for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+    {
+      for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+      {
+        for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
+        {
+          if (mask->GetScalarComponentAsDouble(i, j, k, 0) > 0.0)
+          {
+            labelVoxels[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<unsigned char>(index + 1);
+          }
+        }
+      }
+    }
+  }
+  field->SetProtectedLabels(labels);
+}
+
+//----------------------------------------------------------------------------
+std::string vtkSlicerVolumeCuttingLogic::GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  const std::vector<std::string> protectedIds = cutNode ? cutNode->GetProtectedSegmentIDs() : std::vector<std::string>();
+  const int label = field ? field->GetContactLabel() : 0;
+  return label > 0 && label <= static_cast<int>(protectedIds.size()) ? protectedIds[label - 1] : std::string();
 }
 
 //----------------------------------------------------------------------------

@@ -72,8 +72,10 @@ public:
 
   /// The cut field of a cut node: created on first use on the anatomy's voxel
   /// grid at the node's sub-voxel factor, and created anew (empty) when the
-  /// anatomy's geometry or the factor changes. nullptr (and an error) when the
-  /// node has no anatomy with voxels.
+  /// anatomy's geometry or the factor changes. Its protection follows the
+  /// node's protected segments (labels 1, 2, ... in the order of
+  /// GetProtectedSegmentIDs), updated when they or the segmentation change.
+  /// nullptr (and an error) when the node has no anatomy with voxels.
   vtkVolumeCutField* GetCutField(vtkMRMLVolumeCutNode* cutNode);
 
   ///@{
@@ -102,6 +104,10 @@ public:
   /// nullptr and an error if the node has no cut field.
   vtkMRMLSegmentationNode* ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
 
+  /// The protected segment a tool touched most deeply since the last
+  /// ResetContact of the node's field ("" if none), and how deep (mm).
+  std::string GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode);
+
   /// Total removed volume (mm^3) of the node's cut field.
   double GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode);
 
@@ -120,6 +126,12 @@ protected:
   void OnMRMLSceneNodeRemoved(vtkMRMLNode* node) override;
   void OnMRMLSceneEndClose() override;
   void SetMRMLSceneInternal(vtkMRMLScene* newScene) override;
+
+  /// Give the field the node's protected segments as labels on the anatomy grid.
+  void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
+
+  /// What the protection of each field was last built from.
+  std::map<std::string, std::string> ProtectionSources;
 
   /// Cut fields by cut-node ID. The logic owns them: the node stays a
   /// parameter holder, the field is the Slicer-independent algorithm.

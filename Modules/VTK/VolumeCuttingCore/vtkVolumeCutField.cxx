@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutField.h"
 
+#include "vtkDataArray.h"
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
 #include "vtkImageData.h"
@@ -195,6 +196,13 @@ struct vtkVolumeCutField::Brick
 };
 
 //------------------------------------------------------------------------------
+struct vtkVolumeCutField::ProtectionBrick
+{
+  int16_t Distance[SamplesPerBrick]; // to the union of protected voxel cubes, negative inside
+  uint8_t Label[SamplesPerBrick];    // the nearest protected structure
+};
+
+//------------------------------------------------------------------------------
 struct vtkVolumeCutField::UndoStep
 {
   std::vector<std::pair<vtkIdType, BrickValues>> Before;
@@ -331,6 +339,162 @@ void vtkVolumeCutField::Reset()
   this->UndoMemorySize = 0;
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
+  this->ProtectionBricks.clear();
+  this->ResetContact();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ResetContact()
+{
+  this->MaximumContactDepth = 0.0;
+  this->ContactLabel = 0;
+  std::fill(this->ContactPosition, this->ContactPosition + 3, 0.0);
+}
+
+//------------------------------------------------------------------------------
+const vtkVolumeCutField::ProtectionBrick* vtkVolumeCutField::GetProtectionBrick(vtkIdType brickId) const
+{
+  return this->ProtectionBricks.empty() ? nullptr : this->ProtectionBricks[brickId].get();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
+{
+  this->ProtectionBricks.clear();
+  if (!labels)
+  {
+    return true;
+  }
+  const int f = this->SubVoxelFactor;
+  int dims[3];
+  labels->GetDimensions(dims);
+  if (!this->Directory || f < 1 || dims[0] * f != this->Dimensions[0] || dims[1] * f != this->Dimensions[1] || dims[2] * f != this->Dimensions[2])
+  {
+    vtkErrorMacro("SetProtectedLabels: the labels must have the anatomy's dimensions (" << this->Dimensions[0] / std::max(f, 1) << " x "
+                                                                                        << this->Dimensions[1] / std::max(f, 1) << " x "
+                                                                                        << this->Dimensions[2] / std::max(f, 1) << ")");
+    return false;
+  }
+  vtkDataArray* scalars = labels->GetPointData()->GetScalars();
+  if (!scalars)
+  {
+    vtkErrorMacro("SetProtectedLabels: the labels have no scalars");
+    return false;
+  }
+  const vtkIdType voxelCount = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  std::vector<uint8_t> label(static_cast<size_t>(voxelCount), 0);
+  int lower[3] = { dims[0], dims[1], dims[2] };
+  int upper[3] = { -1, -1, -1 };
+  for (vtkIdType n = 0; n < voxelCount; ++n)
+  {
+    const double value = scalars->GetComponent(n, 0);
+    if (value > 0.0)
+    {
+      label[n] = static_cast<uint8_t>(std::min(255.0, value));
+      const int v[3] = { static_cast<int>(n % dims[0]), static_cast<int>((n / dims[0]) % dims[1]), static_cast<int>(n / (static_cast<vtkIdType>(dims[0]) * dims[1])) };
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        lower[axis] = std::min(lower[axis], v[axis]);
+        upper[axis] = std::max(upper[axis], v[axis]);
+      }
+    }
+  }
+  if (upper[0] < 0)
+  {
+    return true; // nothing protected
+  }
+  // Anatomy spacing along each axis (orthogonal axes: the distance to a voxel
+  // cube is then the per-axis excess over its half width, scaled).
+  double spacing[3];
+  this->GetSubVoxelSpacing(spacing);
+  double anatomySpacing[3] = { spacing[0] * f, spacing[1] * f, spacing[2] * f };
+  const int reach = static_cast<int>(std::ceil(this->BandWidth / std::min({ anatomySpacing[0], anatomySpacing[1], anatomySpacing[2] }))) + 1;
+  auto isProtected = [&](int i, int j, int k) -> uint8_t {
+    if (i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2])
+    {
+      return 0;
+    }
+    return label[(static_cast<size_t>(k) * dims[1] + j) * dims[0] + i];
+  };
+
+  const vtkIdType totalBricks = static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2];
+  this->ProtectionBricks.resize(static_cast<size_t>(totalBricks));
+  int brickLower[3];
+  int brickUpper[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    brickLower[axis] = std::max(0, (lower[axis] - reach) * f) / BrickSize;
+    brickUpper[axis] = std::min(this->Dimensions[axis] - 1, (upper[axis] + reach + 1) * f) / BrickSize;
+  }
+  const double inverseQuantum = 1.0 / this->Quantum;
+  for (int bk = brickLower[2]; bk <= brickUpper[2]; ++bk)
+  {
+    for (int bj = brickLower[1]; bj <= brickUpper[1]; ++bj)
+    {
+      for (int bi = brickLower[0]; bi <= brickUpper[0]; ++bi)
+      {
+        std::unique_ptr<ProtectionBrick> brick(new ProtectionBrick);
+        bool useful = false;
+        for (int local = 0; local < SamplesPerBrick; ++local)
+        {
+          const int s[3] = { bi * BrickSize + local % BrickSize, bj * BrickSize + (local / BrickSize) % BrickSize, bk * BrickSize + local / (BrickSize * BrickSize) };
+          double a[3];
+          int v[3];
+          for (int axis = 0; axis < 3; ++axis)
+          {
+            a[axis] = (s[axis] + 0.5) / f - 0.5;
+            v[axis] = static_cast<int>(std::lround(a[axis]));
+          }
+          const uint8_t own = isProtected(v[0], v[1], v[2]);
+          // Inside: distance to the nearest unprotected cube; outside: to the
+          // nearest protected one. Cubes span index +-0.5 around their voxel.
+          double nearest2 = std::numeric_limits<double>::max();
+          uint8_t nearestLabel = own;
+          for (int dk = -reach; dk <= reach; ++dk)
+          {
+            for (int dj = -reach; dj <= reach; ++dj)
+            {
+              for (int di = -reach; di <= reach; ++di)
+              {
+                const int c[3] = { v[0] + di, v[1] + dj, v[2] + dk };
+                const uint8_t other = isProtected(c[0], c[1], c[2]);
+                if ((own != 0) == (other != 0))
+                {
+                  continue;
+                }
+                double d2 = 0.0;
+                for (int axis = 0; axis < 3; ++axis)
+                {
+                  const double excess = std::max(0.0, std::abs(a[axis] - c[axis]) - 0.5) * anatomySpacing[axis];
+                  d2 += excess * excess;
+                }
+                if (d2 < nearest2)
+                {
+                  nearest2 = d2;
+                  if (!own)
+                  {
+                    nearestLabel = other;
+                  }
+                }
+              }
+            }
+          }
+          const double distance = nearest2 == std::numeric_limits<double>::max() ? this->BandWidth : std::sqrt(nearest2);
+          const double signedDistance = own ? -distance : distance;
+          const double clamped = std::min(this->BandWidth, std::max(-this->BandWidth, signedDistance));
+          brick->Distance[local] = static_cast<int16_t>(std::lround(clamped * inverseQuantum));
+          brick->Label[local] = nearestLabel;
+          useful |= signedDistance < this->BandWidth;
+        }
+        if (useful)
+        {
+          this->ProtectionBricks[(static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi] = std::move(brick);
+        }
+      }
+    }
+  }
+  this->Modified();
+  return true;
 }
 
 //------------------------------------------------------------------------------
@@ -568,6 +732,7 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
         {
           continue; // nothing removed here, nothing to put back
         }
+        const ProtectionBrick* protection = this->GetProtectionBrick(brickId);
         int changes = 0;
         for (int r = 0; r < rowCount; ++r)
         {
@@ -590,7 +755,35 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
             }
             int16_t* merged = &changedValues[changes];
             int rowChanged = 0;
-            if (operation == Operation::Cut)
+            if (operation == Operation::Cut && protection)
+            {
+              // The tool minus the protected voxels: max(tool, -protection).
+              for (int n = 0; n < count; ++n)
+              {
+                const int16_t protectedDistance = protection->Distance[rowStart + n];
+                const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
+                if (quantized[n] < 0 && protectedDistance < 0)
+                {
+                  // A protected sample inside the tool: how far inside (exact,
+                  // not clamped to the band) is the depth of the contact.
+                  const int local = rowStart + n;
+                  const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
+                    double(bk * BrickSize + local / (BrickSize * BrickSize)) };
+                  double point[3];
+                  Transform(this->SubIJKToRAS, index, point);
+                  const double depth = radius - DistanceToSegment(point, p0, ab, abLength2);
+                  if (depth > this->MaximumContactDepth)
+                  {
+                    this->MaximumContactDepth = depth;
+                    this->ContactLabel = protection->Label[local];
+                    std::copy(point, point + 3, this->ContactPosition);
+                  }
+                }
+                merged[n] = effective < old[n] ? effective : old[n];
+                rowChanged |= merged[n] != old[n];
+              }
+            }
+            else if (operation == Operation::Cut)
             {
               for (int n = 0; n < count; ++n)
               {

@@ -153,6 +153,31 @@ public:
   ///@}
 
   /**
+   * Protect structures: anatomy voxels whose label is nonzero are never
+   * removed, whatever the tools do (tool "sensibility", Pflesser et al.).
+   * \a labels has the anatomy's dimensions (IJK geometry; the field's
+   * IJK-to-RAS applies) and one integer component: 0 for voxels a tool may
+   * cut, k > 0 for the k-th protected structure. Protection is exact to the
+   * voxel faces of the labels: the removed region becomes the tool's sweep
+   * minus the union of labelled voxel cubes, sharp edges included. Cuts
+   * already made are not changed. nullptr clears the protection. Returns
+   * false (and an error) if the dimensions differ.
+   */
+  bool SetProtectedLabels(vtkImageData* labels);
+
+  ///@{
+  /**
+   * Contacts with protected structures since the last ResetContact(): the
+   * deepest penetration (mm) of a tool into protected voxels, the structure's
+   * label (0 if none) and where (RAS). A contact removes nothing.
+   */
+  vtkGetMacro(MaximumContactDepth, double);
+  vtkGetMacro(ContactLabel, int);
+  vtkGetVector3Macro(ContactPosition, double);
+  void ResetContact();
+  ///@}
+
+  /**
    * Signed distance (mm) to the boundary of the removed region at a RAS
    * point, trilinearly interpolated with a curvature correction from the
    * samples' second differences; negative where removed. Points outside
@@ -215,6 +240,7 @@ protected:
   ~vtkVolumeCutField() override;
 
   struct Brick;
+  struct ProtectionBrick;
   struct UndoStep;
   enum class Operation
   {
@@ -233,6 +259,7 @@ protected:
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
   void Reset();
+  const ProtectionBrick* GetProtectionBrick(vtkIdType brickId) const;
 
   int Dimensions[3] = { 0, 0, 0 };
   int BrickDimensions[3] = { 0, 0, 0 };
@@ -252,6 +279,13 @@ protected:
   std::unique_ptr<std::atomic<vtkIdType>[]> AllocatedBrickIds;
   std::atomic<vtkIdType> NumberOfAllocatedBricks{ 0 };
   std::vector<std::unique_ptr<Brick>> OwnedBricks;
+  // Protection: per brick near or inside protected voxels, the signed
+  // distance to their union and the nearest structure's label.
+  std::vector<std::unique_ptr<ProtectionBrick>> ProtectionBricks;
+  double MaximumContactDepth = 0.0;
+  int ContactLabel = 0;
+  double ContactPosition[3] = { 0.0, 0.0, 0.0 };
+
   // Writer's scratch: quantised tool distances of the rows of one line of bricks.
   std::vector<int16_t> RowScratch;
   bool StrokeOpen = false;

@@ -169,6 +169,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
             **drilled,
             "removed_volume_mm3": round(logic.GetRemovedVolume(cut_node), 2),
             "removed_volume_per_segment_mm3": removed_per_segment,
+            "deepest_contact_with_protected": {
+                "segment": logic.GetContactSegmentID(cut_node),
+                "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
+            },
         },
         "renderer": renderer,
         "image": str(image_path),

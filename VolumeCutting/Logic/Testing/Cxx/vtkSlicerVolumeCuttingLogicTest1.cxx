@@ -36,7 +36,10 @@
 #include <vtkNew.h>
 
 // STD includes
+#include <array>
 #include <cmath>
+#include <iostream>
+#include <vector>
 
 namespace
 {
@@ -269,6 +272,63 @@ int TestStrokesAndRemovedVolumePerSegment()
   CHECK_DOUBLE(logic->GetRemovedVolumeInSegment(cutNode, "NoSuchSegment"), -1.0);
   TESTING_OUTPUT_ASSERT_ERRORS_END();
   CHECK_DOUBLE_TOLERANCE(logic->GetRemovedVolume(cutNode), volumeBefore, 1e-12);
+
+  // Protecting the cortical shell: a new sweep out through it removes no
+  // more cortical bone, and the contact names the segment.
+  const double corticalBefore = logic->GetRemovedVolumeInSegment(cutNode, vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID());
+  CHECK_BOOL(cutNode->SetSegmentProtected(vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID(), true), true);
+  const double upIjk[4] = { 12.0, 22.0, 10.0, 1.0 };
+  double up[4];
+  ijkToRas->MultiplyPoint(upIjk, up);
+  // The stored samples of the cortical voxels (at their sub-voxel centres,
+  // where interpolation returns the sample itself) that were not removed stay
+  // not removed (their distances may shrink: the cut now reaches the face).
+  vtkVolumeCutField* field = logic->GetCutField(cutNode);
+  std::vector<std::array<double, 3>> corticalCentres;
+  for (int k = 0; k < 20; ++k)
+  {
+    for (int j = 12; j < 24; ++j)
+    {
+      const double r = std::sqrt((j - 12.0) * (j - 12.0) + (k - 10.0) * (k - 10.0));
+      if (r > 6.0 && r <= 8.0)
+      {
+        for (double dj : { -0.25, 0.25 })
+        {
+          for (double dk : { -0.25, 0.25 })
+          {
+            for (double di : { -0.25, 0.25 })
+            {
+              const double index[4] = { 12.0 + di, j + dj, k + dk, 1.0 };
+              double ras[4];
+              ijkToRas->MultiplyPoint(index, ras);
+              corticalCentres.push_back({ ras[0], ras[1], ras[2] });
+            }
+          }
+        }
+      }
+    }
+  }
+  std::vector<double> before;
+  for (const auto& point : corticalCentres)
+  {
+    before.push_back(field->GetSignedDistance(point.data()));
+  }
+  CHECK_BOOL(logic->CutSphereSweep(cutNode, center, up, 1.0), true);
+  for (size_t n = 0; n < corticalCentres.size(); ++n)
+  {
+    if (before[n] > 0.0)
+    {
+      CHECK_BOOL(field->GetSignedDistance(corticalCentres[n].data()) > 0.0, true);
+    }
+  }
+  // The volume reported inside the protected segment may only grow by the
+  // reconstruction's spill across the protected face (a few hundredths of a
+  // voxel over the contact area).
+  const double corticalAfter = logic->GetRemovedVolumeInSegment(cutNode, vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID());
+  std::cout << "removed in the protected cortex: before " << corticalBefore << " mm3, after " << corticalAfter << " mm3" << std::endl;
+  CHECK_BOOL(corticalAfter < corticalBefore + 0.15, true);
+  CHECK_STD_STRING(logic->GetContactSegmentID(cutNode), vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID());
+  CHECK_BOOL(logic->GetCutField(cutNode)->GetMaximumContactDepth() > 0.5, true);
 
   // Another sub-voxel factor means another grid: the field starts anew, with a warning.
   cutNode->SetSubVoxelFactor(4);

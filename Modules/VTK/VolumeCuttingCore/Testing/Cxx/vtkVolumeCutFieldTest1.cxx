@@ -319,6 +319,62 @@ int TestExportAndMemory()
   return EXIT_SUCCESS;
 }
 
+// Protected voxels (a slab i >= 20, label 3) are never removed: a sphere
+// centred on the slab's voxel face removes exactly a hemisphere, and the
+// contact is reported with the structure's label and the tool's overlap.
+int TestProtectedVoxelsAreNeverRemoved()
+{
+  const int dims[3] = { 40, 40, 40 };
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  MakeGrid(ijkToRas);
+  vtkNew<vtkVolumeCutField> field;
+  field->Initialize(dims, ijkToRas, 2);
+  vtkNew<vtkImageData> labels;
+  labels->SetDimensions(dims[0], dims[1], dims[2]);
+  labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  for (int k = 0; k < dims[2]; ++k)
+  {
+    for (int j = 0; j < dims[1]; ++j)
+    {
+      for (int i = 0; i < dims[0]; ++i)
+      {
+        labels->SetScalarComponentFromDouble(i, j, k, 0, i >= 20 ? 3 : 0);
+      }
+    }
+  }
+  CHECK_BOOL(field->SetProtectedLabels(labels), true);
+  const double boundary = 19.5 * 0.5; // voxel face between i = 19 and i = 20
+  const double center[3] = { boundary, 10.1, 9.8 };
+  const double radius = 3.0;
+  CHECK_BOOL(field->CutCapsule(center, center, radius), true);
+  const double hemisphere = 2.0 / 3.0 * Pi * radius * radius * radius;
+  const double error = std::abs(field->ComputeRemovedVolume() - hemisphere) / hemisphere;
+  std::cout << "sphere on a protected face: removed volume error " << 100 * error << " % of a hemisphere" << std::endl;
+  CHECK_BOOL(error < 0.005, true);
+  const double inside[3] = { boundary + 0.05, 10.1, 9.8 };
+  CHECK_BOOL(field->GetSignedDistance(inside) > 0.0, true);
+  const double beside[3] = { boundary - 0.05, 10.1, 9.8 };
+  CHECK_BOOL(field->GetSignedDistance(beside) < 0.0, true);
+  CHECK_INT(field->GetContactLabel(), 3);
+  CHECK_DOUBLE_TOLERANCE(field->GetMaximumContactDepth(), radius, 0.15);
+  CHECK_BOOL(field->GetContactPosition()[0] > boundary, true);
+
+  // Sweeping deep into the slab still leaves it whole.
+  const double deep[3] = { boundary + 8.0, 10.1, 9.8 };
+  field->CutCapsule(center, deep, radius);
+  CHECK_BOOL(std::abs(field->ComputeRemovedVolume() - hemisphere) / hemisphere < 0.005, true);
+  field->ResetContact();
+  CHECK_INT(field->GetContactLabel(), 0);
+
+  // Wrong dimensions are refused.
+  vtkNew<vtkImageData> wrong;
+  wrong->SetDimensions(10, 10, 10);
+  wrong->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(field->SetProtectedLabels(wrong), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  return EXIT_SUCCESS;
+}
 } // namespace
 
 int vtkVolumeCutFieldTest1(int, char*[])
@@ -329,5 +385,6 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestRestoreUndoRedoAndStamps());
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
+  CHECK_EXIT_SUCCESS(TestProtectedVoxelsAreNeverRemoved());
   return EXIT_SUCCESS;
 }
