@@ -46,6 +46,8 @@ def check_outputs(summary, out_dir):
     assert cut.GetAnatomyVolumeNode() is not None
     assert cut.GetSegmentationNode() is not None
     assert json.loads((out_dir / "summary.json").read_text()) == summary
+    assert (out_dir / "removed.stl").stat().st_size > 1000
+    assert reloaded.scene.GetFirstNodeByName(summary["exports"]["drilled_ct"]) is not None
 
 
 def test_main_job_on_the_phantom(tmp_path):

@@ -17,6 +17,8 @@
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
+#include <vtkMRMLModelDisplayNode.h>
+#include <vtkMRMLModelNode.h>
 #include <vtkMRMLScalarVolumeNode.h>
 #include <vtkMRMLScene.h>
 #include <vtkMRMLSegmentationDisplayNode.h>
@@ -41,6 +43,7 @@
 #include <vtkIntArray.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
+#include <vtkPolyData.h>
 
 // STD includes
 #include <cmath>
@@ -621,4 +624,59 @@ vtkMRMLSegmentationNode* vtkSlicerVolumeCuttingLogic::ExportRemovedRegionToSegme
   segment->AddRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName(), mask);
   segmentationNode->GetSegmentation()->AddSegment(segment, "Removed");
   return segmentationNode;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLModelNode* vtkSlicerVolumeCuttingLogic::ExportRemovedSurfaceToModel(vtkMRMLVolumeCutNode* cutNode, const char* name)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field || !this->GetMRMLScene())
+  {
+    return nullptr;
+  }
+  vtkNew<vtkPolyData> surface;
+  field->ExtractRemovedSurface(surface);
+  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed surface";
+  vtkMRMLModelNode* model = vtkMRMLModelNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLModelNode", nodeName));
+  model->SetAndObservePolyData(surface);
+  model->CreateDefaultDisplayNodes();
+  if (model->GetDisplayNode())
+  {
+    model->GetDisplayNode()->SetColor(0.85, 0.15, 0.1);
+  }
+  return model;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportDrilledVolume(vtkMRMLVolumeCutNode* cutNode, double fillValue, const char* name)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field || !this->GetMRMLScene())
+  {
+    return nullptr;
+  }
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkImageData> fraction;
+  field->ExportRemovedFraction(fraction);
+  vtkNew<vtkImageData> drilled;
+  drilled->DeepCopy(anatomy->GetImageData());
+  vtkDataArray* voxels = drilled->GetPointData()->GetScalars();
+  const float* fractions = static_cast<const float*>(fraction->GetScalarPointer());
+  const vtkIdType voxelCount = std::min(drilled->GetNumberOfPoints(), fraction->GetNumberOfPoints());
+  for (vtkIdType n = 0; n < voxelCount; ++n)
+  {
+    if (fractions[n] > 0.0f)
+    {
+      const double value = voxels->GetComponent(n, 0);
+      voxels->SetComponent(n, 0, value + fractions[n] * (fillValue - value));
+    }
+  }
+  const std::string nodeName = name ? name : std::string(anatomy->GetName() ? anatomy->GetName() : "Volume") + " drilled";
+  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLScalarVolumeNode", nodeName));
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  volume->SetIJKToRASMatrix(ijkToRas);
+  volume->SetAndObserveImageData(drilled);
+  volume->CreateDefaultDisplayNodes();
+  return volume;
 }

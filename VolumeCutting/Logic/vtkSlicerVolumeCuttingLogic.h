@@ -24,6 +24,7 @@
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
 
 class vtkMRMLMessageCollection;
+class vtkMRMLModelNode;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
@@ -107,6 +108,17 @@ public:
   /// The protected segment a tool touched most deeply since the last
   /// ResetContact of the node's field ("" if none), and how deep (mm).
   std::string GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode);
+
+  /// Add a model of the removed region's closed boundary, contoured at
+  /// sub-voxel resolution (save it as STL with Slicer's model storage).
+  /// nullptr and an error if the node has no cut field.
+  vtkMRMLModelNode* ExportRemovedSurfaceToModel(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
+
+  /// Add the drilled CT: a copy of the anatomy in which each voxel is blended
+  /// towards \a fillValue (air, -1000 HU) by its removed fraction, so fully
+  /// removed voxels are air and partly removed ones keep partial volume.
+  /// nullptr and an error if the node has no cut field.
+  vtkMRMLScalarVolumeNode* ExportDrilledVolume(vtkMRMLVolumeCutNode* cutNode, double fillValue = -1000.0, const char* name = nullptr);
 
   /// Total removed volume (mm^3) of the node's cut field.
   double GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode);

@@ -3,6 +3,7 @@
 #include "vtkVolumeCutField.h"
 
 #include "vtkDataArray.h"
+#include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
 #include "vtkImageData.h"
@@ -11,6 +12,9 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkTransform.h"
+#include "vtkTransformPolyDataFilter.h"
 
 #include <algorithm>
 #include <cmath>
@@ -1244,4 +1248,63 @@ void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfAllocatedBricks: " << this->GetNumberOfAllocatedBricks() << "\n";
   os << indent << "UndoSteps: " << this->UndoStack.size() << " (" << this->UndoMemorySize / 1024 << " KiB of " << this->UndoMemoryBudget / 1024
      << " KiB)\n";
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ExtractRemovedSurface(vtkPolyData* surface) const
+{
+  if (!surface)
+  {
+    return;
+  }
+  surface->Initialize();
+  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
+  if (!this->Directory || count == 0)
+  {
+    return;
+  }
+  // Sub-voxel box of the allocated bricks, one sample wider on each side so
+  // that the surface closes where the removed region meets the volume's edge.
+  int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
+  int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
+      static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      lower[axis] = std::min(lower[axis], b[axis] * BrickSize - 1);
+      upper[axis] = std::max(upper[axis], b[axis] * BrickSize + BrickSize);
+    }
+  }
+  vtkNew<vtkImageData> samples;
+  samples->SetExtent(lower[0], upper[0], lower[1], upper[1], lower[2], upper[2]);
+  samples->AllocateScalars(VTK_FLOAT, 1);
+  float* values = static_cast<float*>(samples->GetScalarPointer());
+  vtkIdType index = 0;
+  for (int k = lower[2]; k <= upper[2]; ++k)
+  {
+    for (int j = lower[1]; j <= upper[1]; ++j)
+    {
+      for (int i = lower[0]; i <= upper[0]; ++i, ++index)
+      {
+        values[index] = static_cast<float>(this->ReadSample(i, j, k) * this->Quantum);
+      }
+    }
+  }
+  vtkNew<vtkFlyingEdges3D> contour;
+  contour->SetInputData(samples);
+  contour->SetValue(0, 0.0);
+  contour->ComputeNormalsOff();
+  contour->ComputeGradientsOff();
+  contour->ComputeScalarsOff();
+  // Index space to RAS.
+  vtkNew<vtkTransform> subToRas;
+  subToRas->SetMatrix(&this->SubIJKToRAS[0][0]);
+  vtkNew<vtkTransformPolyDataFilter> toRas;
+  toRas->SetInputConnection(contour->GetOutputPort());
+  toRas->SetTransform(subToRas);
+  toRas->Update();
+  surface->ShallowCopy(toRas->GetOutput());
 }

@@ -47,6 +47,7 @@
 class vtkIdList;
 class vtkImageData;
 class vtkMatrix4x4;
+class vtkPolyData;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutField : public vtkObject
 {
@@ -213,6 +214,14 @@ public:
    * node gives IJK-to-RAS), the mean of its sub-voxels' removed fractions.
    */
   void ExportRemovedFraction(vtkImageData* anatomyFraction) const;
+
+  /**
+   * The boundary of the removed region as a closed triangle surface in RAS
+   * (mm), contoured at sub-voxel resolution from the distance samples (flying
+   * edges at distance 0). Empty if nothing is removed. For STL export and for
+   * showing the removed volume as a model.
+   */
+  void ExtractRemovedSurface(vtkPolyData* surface) const;
 
   ///@{
   /**

@@ -185,3 +185,36 @@ def test_bad_inputs_give_errors_not_crashes(scene):
     assert "no voxels" in messages.GetAllMessagesAsString()
     cut.SetSubVoxelFactor(3)
     assert cut.GetSubVoxelFactor() == 2
+
+
+def test_exports_of_the_removed_region(scene, tmp_path):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    assert logic.CutSphereSweep(cut, center, center, 2.0)
+    removed = logic.GetRemovedVolume(cut)
+    assert abs(removed - 4.0 / 3.0 * np.pi * 8.0) / removed < 0.005
+
+    drilled = logic.ExportDrilledVolume(cut, -1000.0, None)
+    original = numpy_support.vtk_to_numpy(volume.GetImageData().GetPointData().GetScalars()).reshape(20, 22, 22)
+    after = numpy_support.vtk_to_numpy(drilled.GetImageData().GetPointData().GetScalars()).reshape(20, 22, 22)
+    assert after[10, 11, 11] == -1000  # the centre voxel is air now
+    assert np.array_equal(after[:, :, :3], original[:, :, :3])  # far away: untouched
+    assert (after <= original).all()  # only ever towards air
+    assert drilled.GetName() == "CT drilled"
+    assert np.allclose(drilled.GetSpacing(), volume.GetSpacing())
+
+    model = logic.ExportRemovedSurfaceToModel(cut, None)
+    assert model.GetPolyData().GetNumberOfCells() > 0
+    storage = model.CreateDefaultStorageNode()
+    storage.SetFileName(str(tmp_path / "removed.stl"))
+    assert storage.WriteData(model)
+    assert (tmp_path / "removed.stl").stat().st_size > 1000
+
+    segmentation = logic.ExportRemovedRegionToSegmentation(cut, "Removed")
+    labelmap = segmentation.GetBinaryLabelmapInternalRepresentation("Removed")
+    counted = numpy_support.vtk_to_numpy(labelmap.GetPointData().GetScalars()).astype(bool).sum()
+    voxel = 0.6 * 0.6 * 1.0
+    assert abs(counted * voxel - removed) / removed < 0.15

@@ -123,11 +123,19 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
         for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
     }
+    # Exports: the removed region as a segment (binary labelmap on the CT's
+    # grid), as a closed surface (STL), and the drilled CT.
     removed = logic.ExportRemovedRegionToSegmentation(cut_node, None)
+    removed.GetDisplayNode().SetVisibility3D(False)
+    removed_model = logic.ExportRemovedSurfaceToModel(cut_node, None)
+    storage = removed_model.CreateDefaultStorageNode()
+    storage.SetFileName(str(out_dir / "removed.stl"))
+    if not storage.WriteData(removed_model):
+        raise RuntimeError("writing removed.stl failed (see the log)")
+    drilled_ct = logic.ExportDrilledVolume(cut_node, -1000.0, None)
 
     with timer.measure("surface_s"):
         bone.CreateClosedSurfaceRepresentation()
-        removed.CreateClosedSurfaceRepresentation()
         if anatomy_segmentation is not None:
             # Show the structures the user must see through the bone.
             anatomy_segmentation.CreateClosedSurfaceRepresentation()
@@ -173,6 +181,12 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
                 "segment": logic.GetContactSegmentID(cut_node),
                 "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
             },
+        },
+        "exports": {
+            "removed_segmentation": removed.GetName(),
+            "removed_surface_stl": str(out_dir / "removed.stl"),
+            "removed_surface_triangles": removed_model.GetPolyData().GetNumberOfCells(),
+            "drilled_ct": drilled_ct.GetName(),
         },
         "renderer": renderer,
         "image": str(image_path),

@@ -62,3 +62,29 @@ def test_bad_poses_are_refused_and_keep_the_cut():
     assert field.ComputeRemovedVolume() == before
     assert not field.Initialize([20, 20, 20], vtk.vtkMatrix4x4(), 3)
     assert field.ComputeRemovedVolume() == before
+
+
+def test_removed_surface_is_closed_and_encloses_the_removed_volume():
+    field = slicer.vtkVolumeCutField()
+    field.Initialize([40, 40, 40], oblique_grid(), 2)
+    center = [2.3, 12.1, 11.7]
+    field.CutCapsule(center, [center[0] + 3.0, center[1] - 1.0, center[2]], 2.5)
+    surface = vtk.vtkPolyData()
+    field.ExtractRemovedSurface(surface)
+    assert surface.GetNumberOfCells() > 100
+    edges = vtk.vtkFeatureEdges()
+    edges.SetInputData(surface)
+    edges.BoundaryEdgesOn()
+    edges.NonManifoldEdgesOn()
+    edges.FeatureEdgesOff()
+    edges.ManifoldEdgesOff()
+    edges.Update()
+    assert edges.GetOutput().GetNumberOfCells() == 0  # closed
+    mass = vtk.vtkMassProperties()
+    mass.SetInputData(surface)
+    mass.Update()
+    assert abs(mass.GetVolume() - field.ComputeRemovedVolume()) / field.ComputeRemovedVolume() < 0.01
+
+    empty = vtk.vtkPolyData()
+    slicer.vtkVolumeCutField().ExtractRemovedSurface(empty)
+    assert empty.GetNumberOfPoints() == 0
