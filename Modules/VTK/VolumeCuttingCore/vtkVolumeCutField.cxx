@@ -15,6 +15,7 @@
 #include "vtkPolyData.h"
 #include "vtkTransform.h"
 #include "vtkTransformPolyDataFilter.h"
+#include "vtkVolumeCutTool.h"
 
 #include <algorithm>
 #include <cmath>
@@ -320,6 +321,7 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
   this->Quantum = this->BandWidth / (Outside - 1);
   this->HalfDiagonal = 0.5 * std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
   this->RowScratch.assign(static_cast<size_t>(BrickSize) * BrickSize * dimensions[0], Outside);
+  this->DistanceScratch.assign(static_cast<size_t>(dimensions[0]), 0.0f);
   const vtkIdType totalBricks = static_cast<vtkIdType>(brickCount);
   this->Directory.reset(new std::atomic<Brick*>[totalBricks]);
   this->AllocatedBrickIds.reset(new std::atomic<vtkIdType>[totalBricks]);
@@ -597,6 +599,319 @@ void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick
 }
 
 //------------------------------------------------------------------------------
+/// What ApplyDistance needs to know of a tool sweep: where it reaches and its
+/// signed distance (mm, negative inside), per grid row or at a point.
+struct vtkVolumeCutField::DistanceSource
+{
+  virtual ~DistanceSource() = default;
+  /// RAS box holding every point within reach (the swept tool grown by the band).
+  virtual void GetReachBounds(double lower[3], double upper[3]) const = 0;
+  /// Stretch [first, last] (row index units) of the row origin + t * step within reach.
+  virtual bool RowInterval(const double origin[3], double& first, double& last) const = 0;
+  /// Distances at t = first .. last into distances[0 .. last - first].
+  virtual void RowDistances(const double origin[3], int first, int last, float* distances) const = 0;
+  /// Distance at one point (contacts).
+  virtual double Distance(const double point[3]) const = 0;
+};
+
+namespace
+{
+/// The sweep of a sphere: a capsule, with closed-form row intervals and a
+/// vectorised distance loop.
+class CapsuleSource : public vtkVolumeCutField::DistanceSource
+{
+public:
+  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3])
+    : Radius(radius)
+    , Reach(reach)
+    , Intersector(p0, p1, reach, rowStep)
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      this->P0[axis] = p0[axis];
+      this->P1[axis] = p1[axis];
+      this->Ab[axis] = p1[axis] - p0[axis];
+      this->Step[axis] = rowStep[axis];
+    }
+    this->AbLength2 = this->Ab[0] * this->Ab[0] + this->Ab[1] * this->Ab[1] + this->Ab[2] * this->Ab[2];
+  }
+  void GetReachBounds(double lower[3], double upper[3]) const override
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      lower[axis] = std::min(this->P0[axis], this->P1[axis]) - this->Reach;
+      upper[axis] = std::max(this->P0[axis], this->P1[axis]) + this->Reach;
+    }
+  }
+  bool RowInterval(const double origin[3], double& first, double& last) const override { return this->Intersector.Intersect(origin, first, last); }
+  void RowDistances(const double origin[3], int first, int last, float* distances) const override
+  {
+    // Single precision: the quantum is 1e-5 of the band, far above float
+    // rounding at these distances; the loop vectorises.
+    const float w0[3] = { static_cast<float>(origin[0] + first * this->Step[0] - this->P0[0]),
+      static_cast<float>(origin[1] + first * this->Step[1] - this->P0[1]), static_cast<float>(origin[2] + first * this->Step[2] - this->P0[2]) };
+    const float step[3] = { static_cast<float>(this->Step[0]), static_cast<float>(this->Step[1]), static_cast<float>(this->Step[2]) };
+    const float ab[3] = { static_cast<float>(this->Ab[0]), static_cast<float>(this->Ab[1]), static_cast<float>(this->Ab[2]) };
+    const float inverseLength2 = this->AbLength2 > 0.0 ? static_cast<float>(1.0 / this->AbLength2) : 0.0f;
+    const float radius = static_cast<float>(this->Radius);
+    const int count = last - first + 1;
+    for (int n = 0; n < count; ++n)
+    {
+      const float t = static_cast<float>(n);
+      const float wx = w0[0] + t * step[0];
+      const float wy = w0[1] + t * step[1];
+      const float wz = w0[2] + t * step[2];
+      float along = (wx * ab[0] + wy * ab[1] + wz * ab[2]) * inverseLength2;
+      along = along < 0.0f ? 0.0f : along;
+      along = along > 1.0f ? 1.0f : along;
+      const float dx = wx - along * ab[0];
+      const float dy = wy - along * ab[1];
+      const float dz = wz - along * ab[2];
+      distances[n] = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
+    }
+  }
+  double Distance(const double point[3]) const override { return DistanceToSegment(point, this->P0, this->Ab, this->AbLength2) - this->Radius; }
+
+private:
+  double P0[3];
+  double P1[3];
+  double Ab[3];
+  double Step[3];
+  double AbLength2 = 0.0;
+  double Radius;
+  double Reach;
+  CapsuleRowIntersector Intersector;
+};
+} // namespace
+
+namespace
+{
+/// A rigid pose: tool-to-RAS rotation and translation.
+struct RigidPose
+{
+  double Rotation[3][3];
+  double Translation[3];
+};
+
+/// The sweep of any tool: the tool at poses close enough that the union of
+/// its copies covers the continuous sweep to within half a sub-voxel.
+class SweptToolSource : public vtkVolumeCutField::DistanceSource
+{
+public:
+  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach, const double rowStep[3])
+    : Tool(tool)
+    , Poses(std::move(poses))
+    , Reach(reach)
+  {
+    std::copy(rowStep, rowStep + 3, this->Step);
+  }
+  void GetReachBounds(double lower[3], double upper[3]) const override
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      lower[axis] = std::numeric_limits<double>::max();
+      upper[axis] = -std::numeric_limits<double>::max();
+      for (const RigidPose& pose : this->Poses)
+      {
+        lower[axis] = std::min(lower[axis], pose.Translation[axis] - this->Reach);
+        upper[axis] = std::max(upper[axis], pose.Translation[axis] + this->Reach);
+      }
+    }
+  }
+  bool RowInterval(const double origin[3], double& first, double& last) const override
+  {
+    first = std::numeric_limits<double>::max();
+    last = -std::numeric_limits<double>::max();
+    const double a = this->Step[0] * this->Step[0] + this->Step[1] * this->Step[1] + this->Step[2] * this->Step[2];
+    for (const RigidPose& pose : this->Poses)
+    {
+      const double w[3] = { origin[0] - pose.Translation[0], origin[1] - pose.Translation[1], origin[2] - pose.Translation[2] };
+      const double b = 2.0 * (w[0] * this->Step[0] + w[1] * this->Step[1] + w[2] * this->Step[2]);
+      const double c = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - this->Reach * this->Reach;
+      const double discriminant = b * b - 4.0 * a * c;
+      if (discriminant >= 0.0)
+      {
+        const double root = std::sqrt(discriminant);
+        first = std::min(first, (-b - root) / (2.0 * a));
+        last = std::max(last, (-b + root) / (2.0 * a));
+      }
+    }
+    return first <= last;
+  }
+  void RowDistances(const double origin[3], int first, int last, float* distances) const override
+  {
+    for (int i = first; i <= last; ++i)
+    {
+      const double point[3] = { origin[0] + i * this->Step[0], origin[1] + i * this->Step[1], origin[2] + i * this->Step[2] };
+      distances[i - first] = static_cast<float>(this->Distance(point));
+    }
+  }
+  double Distance(const double point[3]) const override
+  {
+    double nearest = this->Reach; // beyond the band: any value this large is clamped
+    for (const RigidPose& pose : this->Poses)
+    {
+      const double w[3] = { point[0] - pose.Translation[0], point[1] - pose.Translation[1], point[2] - pose.Translation[2] };
+      const double centreDistance2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+      if (centreDistance2 > this->Reach * this->Reach)
+      {
+        continue; // this copy of the tool is farther than the band
+      }
+      double local[3];
+      for (int row = 0; row < 3; ++row)
+      {
+        local[row] = pose.Rotation[0][row] * w[0] + pose.Rotation[1][row] * w[1] + pose.Rotation[2][row] * w[2];
+      }
+      nearest = std::min(nearest, this->Tool->EvaluateDistance(local));
+    }
+    return nearest;
+  }
+
+private:
+  vtkVolumeCutTool* Tool;
+  std::vector<RigidPose> Poses;
+  double Step[3];
+  double Reach;
+};
+
+bool ToRigidPose(vtkMatrix4x4* matrix, RigidPose& pose)
+{
+  if (!matrix)
+  {
+    return false;
+  }
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      pose.Rotation[row][column] = matrix->GetElement(row, column);
+    }
+    pose.Translation[row] = matrix->GetElement(row, 3);
+  }
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      if (!std::isfinite(matrix->GetElement(row, column)))
+      {
+        return false;
+      }
+    }
+  }
+  // Rigid: orthonormal columns, no reflection.
+  for (int a = 0; a < 3; ++a)
+  {
+    for (int b = 0; b < 3; ++b)
+    {
+      double dot = 0.0;
+      for (int row = 0; row < 3; ++row)
+      {
+        dot += pose.Rotation[row][a] * pose.Rotation[row][b];
+      }
+      if (std::abs(dot - (a == b ? 1.0 : 0.0)) > 1e-6)
+      {
+        return false;
+      }
+    }
+  }
+  return vtkMath::Determinant3x3(pose.Rotation) > 0.0;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CutToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  return this->ApplyToolSweep(tool, pose0, pose1, Operation::Cut);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::RestoreToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  return this->ApplyToolSweep(tool, pose0, pose1, Operation::Restore);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, Operation operation)
+{
+  const char* caller = operation == Operation::Cut ? "CutToolSweep" : "RestoreToolSweep";
+  if (!this->Directory)
+  {
+    vtkErrorMacro(<< caller << ": the cut field is not initialized");
+    return false;
+  }
+  if (!tool || !tool->IsValid())
+  {
+    vtkErrorMacro(<< caller << ": no valid tool; nothing was cut");
+    return false;
+  }
+  RigidPose start;
+  RigidPose end;
+  if (!ToRigidPose(pose0, start) || !ToRigidPose(pose1, end))
+  {
+    vtkErrorMacro(<< caller << ": a tool pose is not a finite rigid transform; nothing was cut");
+    return false;
+  }
+  const double jump = std::sqrt(vtkMath::Distance2BetweenPoints(start.Translation, end.Translation));
+  if (jump > this->MaximumStrokeLength)
+  {
+    vtkErrorMacro(<< caller << ": the tool jumped " << jump << " mm between two poses, more than the " << this->MaximumStrokeLength
+                  << " mm accepted as one stroke; nothing was cut");
+    return false;
+  }
+  // Rotation between the poses as a quaternion; intermediate poses by
+  // spherical interpolation, dense enough that no tool point moves more than
+  // half a sub-voxel from one to the next.
+  double q0[4];
+  double q1[4];
+  vtkMath::Matrix3x3ToQuaternion(start.Rotation, q0);
+  vtkMath::Matrix3x3ToQuaternion(end.Rotation, q1);
+  double cosine = q0[0] * q1[0] + q0[1] * q1[1] + q0[2] * q1[2] + q0[3] * q1[3];
+  if (cosine < 0.0)
+  {
+    cosine = -cosine;
+    for (double& component : q1)
+    {
+      component = -component;
+    }
+  }
+  const double angle = 2.0 * std::acos(std::min(1.0, cosine));
+  double spacing[3];
+  this->GetSubVoxelSpacing(spacing);
+  const double step = 0.5 * std::min({ spacing[0], spacing[1], spacing[2] });
+  const double travel = jump + angle * tool->GetBoundingRadius();
+  const int intervals = std::max(1, std::min(100000, static_cast<int>(std::ceil(travel / step))));
+  std::vector<RigidPose> poses(static_cast<size_t>(intervals) + 1);
+  for (int n = 0; n <= intervals; ++n)
+  {
+    const double t = static_cast<double>(n) / intervals;
+    double q[4];
+    const double half = 0.5 * angle;
+    if (half < 1e-9)
+    {
+      std::copy(q0, q0 + 4, q);
+    }
+    else
+    {
+      const double w0 = std::sin((1.0 - t) * half) / std::sin(half);
+      const double w1 = std::sin(t * half) / std::sin(half);
+      for (int c = 0; c < 4; ++c)
+      {
+        q[c] = w0 * q0[c] + w1 * q1[c];
+      }
+    }
+    vtkMath::QuaternionToMatrix3x3(q, poses[n].Rotation);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      poses[n].Translation[axis] = (1.0 - t) * start.Translation[axis] + t * end.Translation[axis];
+    }
+  }
+  const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
+  const SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth, rowStep);
+  this->ApplyDistance(source, operation);
+  return true;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], double radius, Operation operation)
 {
   const char* caller = operation == Operation::Cut ? "CutCapsule" : "RestoreCapsule";
@@ -604,9 +919,19 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
   {
     return false;
   }
+  const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
+  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep);
+  this->ApplyDistance(source, operation);
+  return true;
+}
 
-  // Sub-voxel index range of the capsule grown by the band.
-  const double reach = radius + this->BandWidth;
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation operation)
+{
+  // Sub-voxel index range of the reach box.
+  double reachLower[3];
+  double reachUpper[3];
+  source.GetReachBounds(reachLower, reachUpper);
   int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
   int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
   for (int corner = 0; corner < 8; ++corner)
@@ -614,7 +939,7 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
     double ras[3];
     for (int axis = 0; axis < 3; ++axis)
     {
-      ras[axis] = (corner >> axis) & 1 ? std::max(p0[axis], p1[axis]) + reach : std::min(p0[axis], p1[axis]) - reach;
+      ras[axis] = (corner >> axis) & 1 ? reachUpper[axis] : reachLower[axis];
     }
     double index[3];
     Transform(this->RASToSubIJK, ras, index);
@@ -632,7 +957,7 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
     upper[axis] = std::min(upper[axis], this->Dimensions[axis] - 1);
     if (lower[axis] > upper[axis])
     {
-      return true; // wholly outside the volume: nothing to do
+      return; // wholly outside the volume: nothing to do
     }
   }
 
@@ -641,63 +966,26 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
   {
     this->BeginStroke();
   }
-  const double ab[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
-  const double abLength2 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
-  const double inverseQuantum = 1.0 / this->Quantum;
-  const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
-  const CapsuleRowIntersector intersector(p0, p1, reach, rowStep);
-  const float stepF[3] = { static_cast<float>(rowStep[0]), static_cast<float>(rowStep[1]), static_cast<float>(rowStep[2]) };
-  const float abF[3] = { static_cast<float>(ab[0]), static_cast<float>(ab[1]), static_cast<float>(ab[2]) };
-  const float inverseAbLength2F = abLength2 > 0.0 ? static_cast<float>(1.0 / abLength2) : 0.0f;
-  const float radiusF = static_cast<float>(radius);
-  const float inverseQuantumF = static_cast<float>(inverseQuantum);
+  const float inverseQuantum = static_cast<float>(1.0 / this->Quantum);
   const float insideF = static_cast<float>(Inside);
   const float outsideF = static_cast<float>(Outside);
+  const float sign = operation == Operation::Cut ? 1.0f : -1.0f;
   int16_t changedValues[SamplesPerBrick];
   int changedIndices[SamplesPerBrick];
   bool anyChange = false;
 
-  // The tool's quantised distance along a row, in a loop the compiler
-  // vectorises (single precision: the quantum is 1e-5 of the band, far above
-  // float rounding at these distances).
-  const float sign = operation == Operation::Cut ? 1.0f : -1.0f;
-  auto QuantizeRow = [&](const double origin[3], int first, int last, int16_t* out) {
-    const float w0[3] = { static_cast<float>(origin[0] + first * rowStep[0] - p0[0]), static_cast<float>(origin[1] + first * rowStep[1] - p0[1]),
-      static_cast<float>(origin[2] + first * rowStep[2] - p0[2]) };
-    const int count = last - first + 1;
-    int16_t* target = out + first;
-    for (int n = 0; n < count; ++n)
-    {
-      const float t = static_cast<float>(n);
-      const float wx = w0[0] + t * stepF[0];
-      const float wy = w0[1] + t * stepF[1];
-      const float wz = w0[2] + t * stepF[2];
-      float along = (wx * abF[0] + wy * abF[1] + wz * abF[2]) * inverseAbLength2F;
-      along = along < 0.0f ? 0.0f : along;
-      along = along > 1.0f ? 1.0f : along;
-      const float dx = wx - along * abF[0];
-      const float dy = wy - along * abF[1];
-      const float dz = wz - along * abF[2];
-      float scaled = sign * (std::sqrt(dx * dx + dy * dy + dz * dz) - radiusF) * inverseQuantumF;
-      scaled = scaled < insideF ? insideF : scaled;
-      scaled = scaled > outsideF ? outsideF : scaled;
-      // Round to nearest through truncation of a positive number.
-      target[n] = static_cast<int16_t>(static_cast<int>(scaled + 32768.5f) - 32768);
-    }
-  };
   struct Row
   {
     int First;
     int Last;
     int LocalOffset; // (k, j) part of the sample index inside the brick
-    double Origin[3];
   };
   Row rows[BrickSize * BrickSize];
   for (int bk = lower[2] / BrickSize; bk <= upper[2] / BrickSize; ++bk)
   {
     for (int bj = lower[1] / BrickSize; bj <= upper[1] / BrickSize; ++bj)
     {
-      // Rows of this line of bricks: where each crosses the grown capsule is
+      // Rows of this line of bricks: where each crosses the reach is
       // computed once, then split among the bricks along it.
       int rowCount = 0;
       for (int k = std::max(lower[2], bk * BrickSize); k <= std::min(upper[2], bk * BrickSize + BrickSize - 1); ++k)
@@ -706,10 +994,11 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
         {
           Row& row = rows[rowCount];
           const double rowOriginIndex[3] = { 0.0, static_cast<double>(j), static_cast<double>(k) };
-          Transform(this->SubIJKToRAS, rowOriginIndex, row.Origin);
+          double origin[3];
+          Transform(this->SubIJKToRAS, rowOriginIndex, origin);
           double first;
           double last;
-          if (!intersector.Intersect(row.Origin, first, last))
+          if (!source.RowInterval(origin, first, last))
           {
             continue;
           }
@@ -720,7 +1009,18 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
             continue;
           }
           row.LocalOffset = ((k - bk * BrickSize) * BrickSize + (j - bj * BrickSize)) * BrickSize;
-          QuantizeRow(row.Origin, row.First, row.Last, &this->RowScratch[static_cast<size_t>(rowCount) * this->Dimensions[0]]);
+          float* distances = &this->DistanceScratch[row.First];
+          source.RowDistances(origin, row.First, row.Last, distances);
+          int16_t* quantized = &this->RowScratch[static_cast<size_t>(rowCount) * this->Dimensions[0] + row.First];
+          const int count = row.Last - row.First + 1;
+          for (int n = 0; n < count; ++n)
+          {
+            float scaled = sign * distances[n] * inverseQuantum;
+            scaled = scaled < insideF ? insideF : scaled;
+            scaled = scaled > outsideF ? outsideF : scaled;
+            // Round to nearest through truncation of a positive number.
+            quantized[n] = static_cast<int16_t>(static_cast<int>(scaled + 32768.5f) - 32768);
+          }
           ++rowCount;
         }
       }
@@ -747,70 +1047,68 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
           {
             continue;
           }
+          const int count = iEnd - iBegin + 1;
+          const int16_t* quantized = &this->RowScratch[static_cast<size_t>(r) * this->Dimensions[0] + iBegin];
+          const int rowStart = row.LocalOffset + (iBegin - bi * BrickSize);
+          int16_t old[BrickSize];
+          for (int n = 0; n < count; ++n)
           {
-            const int count = iEnd - iBegin + 1;
-            const int16_t* quantized = &this->RowScratch[static_cast<size_t>(r) * this->Dimensions[0] + iBegin];
-            const int rowStart = row.LocalOffset + (iBegin - bi * BrickSize);
-            // Cut: min(field, tool distance). Restore: max(field, -tool distance).
-            int16_t old[BrickSize];
+            old[n] = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
+          }
+          // Cut: min(field, tool distance). Restore: max(field, -tool distance).
+          int16_t* merged = &changedValues[changes];
+          int rowChanged = 0;
+          if (operation == Operation::Cut && protection)
+          {
+            // The tool minus the protected voxels: max(tool, -protection).
             for (int n = 0; n < count; ++n)
             {
-              old[n] = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
-            }
-            int16_t* merged = &changedValues[changes];
-            int rowChanged = 0;
-            if (operation == Operation::Cut && protection)
-            {
-              // The tool minus the protected voxels: max(tool, -protection).
-              for (int n = 0; n < count; ++n)
+              const int16_t protectedDistance = protection->Distance[rowStart + n];
+              const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
+              if (quantized[n] < 0 && protectedDistance < 0)
               {
-                const int16_t protectedDistance = protection->Distance[rowStart + n];
-                const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
-                if (quantized[n] < 0 && protectedDistance < 0)
+                // A protected sample inside the tool: how far inside (exact,
+                // not clamped to the band) is the depth of the contact.
+                const int local = rowStart + n;
+                const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
+                  double(bk * BrickSize + local / (BrickSize * BrickSize)) };
+                double point[3];
+                Transform(this->SubIJKToRAS, index, point);
+                const double depth = -source.Distance(point);
+                if (depth > this->MaximumContactDepth)
                 {
-                  // A protected sample inside the tool: how far inside (exact,
-                  // not clamped to the band) is the depth of the contact.
-                  const int local = rowStart + n;
-                  const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
-                    double(bk * BrickSize + local / (BrickSize * BrickSize)) };
-                  double point[3];
-                  Transform(this->SubIJKToRAS, index, point);
-                  const double depth = radius - DistanceToSegment(point, p0, ab, abLength2);
-                  if (depth > this->MaximumContactDepth)
-                  {
-                    this->MaximumContactDepth = depth;
-                    this->ContactLabel = protection->Label[local];
-                    std::copy(point, point + 3, this->ContactPosition);
-                  }
+                  this->MaximumContactDepth = depth;
+                  this->ContactLabel = protection->Label[local];
+                  std::copy(point, point + 3, this->ContactPosition);
                 }
-                merged[n] = effective < old[n] ? effective : old[n];
-                rowChanged |= merged[n] != old[n];
               }
+              merged[n] = effective < old[n] ? effective : old[n];
+              rowChanged |= merged[n] != old[n];
             }
-            else if (operation == Operation::Cut)
+          }
+          else if (operation == Operation::Cut)
+          {
+            for (int n = 0; n < count; ++n)
             {
-              for (int n = 0; n < count; ++n)
-              {
-                merged[n] = quantized[n] < old[n] ? quantized[n] : old[n];
-                rowChanged |= merged[n] != old[n];
-              }
+              merged[n] = quantized[n] < old[n] ? quantized[n] : old[n];
+              rowChanged |= merged[n] != old[n];
             }
-            else
+          }
+          else
+          {
+            for (int n = 0; n < count; ++n)
             {
-              for (int n = 0; n < count; ++n)
-              {
-                merged[n] = quantized[n] > old[n] ? quantized[n] : old[n];
-                rowChanged |= merged[n] != old[n];
-              }
+              merged[n] = quantized[n] > old[n] ? quantized[n] : old[n];
+              rowChanged |= merged[n] != old[n];
             }
-            if (rowChanged)
+          }
+          if (rowChanged)
+          {
+            for (int n = 0; n < count; ++n)
             {
-              for (int n = 0; n < count; ++n)
-              {
-                changedIndices[changes + n] = rowStart + n;
-              }
-              changes += count;
+              changedIndices[changes + n] = rowStart + n;
             }
+            changes += count;
           }
         }
         if (changes == 0)
@@ -844,7 +1142,6 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
   {
     this->Modified();
   }
-  return true;
 }
 
 //------------------------------------------------------------------------------

@@ -48,6 +48,7 @@ class vtkIdList;
 class vtkImageData;
 class vtkMatrix4x4;
 class vtkPolyData;
+class vtkVolumeCutTool;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutField : public vtkObject
 {
@@ -117,6 +118,21 @@ public:
    * CutCapsule; one undo step.
    */
   bool RestoreCapsule(const double p0[3], const double p1[3], double radius);
+
+  /**
+   * Remove the volume swept by any tool (vtkVolumeCutTool: cylinder or disk,
+   * ellipsoid, box or blade, closed mesh) moving rigidly from pose0 to pose1
+   * (tool-to-RAS matrices, mm). Between the poses the tool is placed at
+   * intermediate poses (linear translation, spherical rotation) no farther
+   * apart than half a sub-voxel at any point of the tool, so the sweep has no
+   * gaps. Returns false and logs an error, changing nothing, for an invalid
+   * tool, a pose that is not finite or not rigid, or a jump longer than
+   * MaximumStrokeLength. One undo step outside a stroke.
+   */
+  bool CutToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+
+  /// Put back removed material inside the tool's sweep (as CutToolSweep).
+  bool RestoreToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
 
   ///@{
   /**
@@ -250,6 +266,12 @@ protected:
 
   struct Brick;
   struct ProtectionBrick;
+
+public:
+  /// Internal: a tool sweep's reach and distances (defined in the .cxx).
+  struct DistanceSource;
+
+protected:
   struct UndoStep;
   enum class Operation
   {
@@ -260,6 +282,8 @@ protected:
   using BrickValues = std::vector<int16_t>;
 
   bool ApplyCapsule(const double p0[3], const double p1[3], double radius, Operation operation);
+  void ApplyDistance(const DistanceSource& source, Operation operation);
+  bool ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, Operation operation);
   bool ValidateStroke(const double p0[3], const double p1[3], double radius, const char* caller) const;
   Brick* GetOrCreateBrick(vtkIdType brickId);
   void RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick);
@@ -297,6 +321,7 @@ protected:
 
   // Writer's scratch: quantised tool distances of the rows of one line of bricks.
   std::vector<int16_t> RowScratch;
+  std::vector<float> DistanceScratch;
   bool StrokeOpen = false;
   // Bricks touched by the open stroke: their values before it began.
   std::map<vtkIdType, BrickValues> StrokeBefore;

@@ -88,3 +88,110 @@ def test_removed_surface_is_closed_and_encloses_the_removed_volume():
     empty = vtk.vtkPolyData()
     slicer.vtkVolumeCutField().ExtractRemovedSurface(empty)
     assert empty.GetNumberOfPoints() == 0
+
+
+def pose(translation, axis=(0.0, 0.0, 1.0), degrees=0.0):
+    transform = vtk.vtkTransform()
+    transform.Translate(*translation)
+    transform.RotateWXYZ(degrees, *axis)
+    return transform.GetMatrix()
+
+
+def fresh_field(dims=(60, 60, 60), spacing=0.5):
+    matrix = vtk.vtkMatrix4x4()
+    for axis in range(3):
+        matrix.SetElement(axis, axis, spacing)
+    field = slicer.vtkVolumeCutField()
+    assert field.Initialize(list(dims), matrix, 2)
+    return field
+
+
+@pytest.mark.parametrize("kind", ["cylinder", "box", "ellipsoid"])
+def test_tool_shapes_remove_their_exact_volume(kind):
+    field = fresh_field()
+    if kind == "cylinder":
+        tool = slicer.vtkVolumeCutCylinderTool()
+        tool.SetRadius(2.0)
+        tool.SetLength(6.0)
+        exact, tolerance = math.pi * 4.0 * 6.0, 0.01
+    elif kind == "box":
+        tool = slicer.vtkVolumeCutBoxTool()
+        tool.SetSize(8.0, 1.5, 5.0)
+        exact, tolerance = 8.0 * 1.5 * 5.0, 0.01
+    else:
+        tool = slicer.vtkVolumeCutEllipsoidTool()
+        tool.SetRadii(2.0, 3.0, 4.0)
+        exact, tolerance = 4.0 / 3.0 * math.pi * 24.0, 0.005
+    at = pose([14.9, 15.2, 14.7], axis=(1.0, 1.0, 0.0), degrees=30.0)
+    assert field.CutToolSweep(tool, at, at)
+    assert abs(field.ComputeRemovedVolume() - exact) / exact < tolerance
+
+
+def test_a_translated_blade_cuts_a_slot_without_gaps():
+    field = fresh_field()
+    blade = slicer.vtkVolumeCutBoxTool()
+    # 1 mm thick: four sub-voxels. Thinner blades are reconstructed with
+    # larger errors (a sampled distance cannot hold a slab of two samples).
+    blade.SetSize(4.0, 1.0, 5.0)
+    # Along its own x: the slot is the blade extruded by the travel.
+    assert field.CutToolSweep(blade, pose([10.0, 15.0, 15.0]), pose([18.0, 15.0, 15.0]))
+    exact = (4.0 + 8.0) * 1.0 * 5.0
+    assert abs(field.ComputeRemovedVolume() - exact) / exact < 0.02
+
+
+def test_a_rotating_disk_saw_sweeps_every_angle():
+    field = fresh_field()
+    saw = slicer.vtkVolumeCutCylinderTool()
+    saw.SetRadius(6.0)
+    saw.SetLength(0.4)  # a disk
+    centre = [15.0, 15.0, 15.0]
+    # The disk (normal along z) tilts 90 degrees about x: a half ball of
+    # rotation, which sampled poses must cover at every intermediate angle.
+    assert field.CutToolSweep(saw, pose(centre), pose(centre, axis=(1.0, 0.0, 0.0), degrees=90.0))
+    for degrees in (10.0, 37.0, 45.0, 71.0):
+        angle = math.radians(degrees)
+        # A point of the disk's rim region at that tilt: radius 4 mm along y rotated about x.
+        point = [centre[0], centre[1] + 4.0 * math.cos(angle), centre[2] + 4.0 * math.sin(angle)]
+        assert field.GetSignedDistance(point) < 0.0, degrees
+
+
+def test_mesh_tool_and_its_refusals():
+    sphere = vtk.vtkSphereSource()
+    sphere.SetRadius(3.0)
+    sphere.SetThetaResolution(64)
+    sphere.SetPhiResolution(64)
+    sphere.Update()
+    tool = slicer.vtkVolumeCutMeshTool()
+    tool.SetSurface(sphere.GetOutput())
+    assert tool.IsValid()
+    field = fresh_field()
+    at = pose([15.0, 15.0, 15.0])
+    assert field.CutToolSweep(tool, at, at)
+    mass = vtk.vtkMassProperties()
+    mass.SetInputData(sphere.GetOutput())
+    mass.Update()
+    assert abs(field.ComputeRemovedVolume() - mass.GetVolume()) / mass.GetVolume() < 0.01
+
+    # An open surface has no inside: refused, nothing cut.
+    plane = vtk.vtkPlane()
+    plane.SetNormal(0.0, 0.0, 1.0)
+    clip = vtk.vtkClipPolyData()
+    clip.SetInputConnection(sphere.GetOutputPort())
+    clip.SetClipFunction(plane)
+    clip.Update()
+    open_tool = slicer.vtkVolumeCutMeshTool()
+    open_tool.SetSurface(clip.GetOutput())
+    assert not open_tool.IsValid()
+    before = field.ComputeRemovedVolume()
+    assert not field.CutToolSweep(open_tool, at, at)
+    # Non-rigid or non-finite poses, and bad sizes, are refused too.
+    scaled = vtk.vtkMatrix4x4()
+    scaled.SetElement(0, 0, 2.0)
+    assert not field.CutToolSweep(tool, scaled, scaled)
+    broken = vtk.vtkMatrix4x4()
+    broken.SetElement(1, 3, float("nan"))
+    assert not field.CutToolSweep(tool, broken, at)
+    bad = slicer.vtkVolumeCutCylinderTool()
+    bad.SetRadius(-1.0)
+    assert not field.CutToolSweep(bad, at, at)
+    assert field.ComputeRemovedVolume() == before

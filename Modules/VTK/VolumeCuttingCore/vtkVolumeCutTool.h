@@ -1,0 +1,49 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+/**
+ * @class   vtkVolumeCutTool
+ * @brief   Shape of a cutting tool, as a signed distance in its own frame.
+ *
+ * A tool is a closed solid given in its local frame (mm): its signed distance
+ * (negative inside) and the radius of a sphere about the local origin that
+ * holds it. vtkVolumeCutField sweeps it between two poses. The spherical burr
+ * has a faster path of its own (vtkVolumeCutField::CutCapsule); subclasses
+ * give burrs of other shapes, blades, saws, or any closed mesh.
+ *
+ * @sa vtkVolumeCutCylinderTool vtkVolumeCutEllipsoidTool vtkVolumeCutBoxTool vtkVolumeCutMeshTool
+ */
+
+#ifndef vtkVolumeCutTool_h
+#define vtkVolumeCutTool_h
+
+#include "vtkObject.h"
+#include "vtkVolumeCuttingCoreExport.h" // For export macro
+
+class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutTool : public vtkObject
+{
+public:
+  vtkTypeMacro(vtkVolumeCutTool, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// Signed distance (mm) from a point in the tool's frame to its surface;
+  /// negative inside. It must be exact near the surface (within the cut
+  /// field's band) and may underestimate farther away.
+  virtual double EvaluateDistance(const double local[3]) = 0;
+
+  /// Radius (mm) of a sphere about the local origin that holds the tool.
+  virtual double GetBoundingRadius() = 0;
+
+  /// Whether the tool can cut: finite, positive sizes (and a closed surface for
+  /// meshes). Logs an error saying what is wrong otherwise.
+  virtual bool IsValid() = 0;
+
+protected:
+  vtkVolumeCutTool() = default;
+  ~vtkVolumeCutTool() override = default;
+
+private:
+  vtkVolumeCutTool(const vtkVolumeCutTool&) = delete;
+  void operator=(const vtkVolumeCutTool&) = delete;
+};
+
+#endif
