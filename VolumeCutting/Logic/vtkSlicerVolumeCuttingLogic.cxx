@@ -13,6 +13,7 @@
 // VolumeCutting includes
 #include "vtkImageBoneSegmentation.h"
 #include "vtkMRMLVolumeCutNode.h"
+#include "vtkMRMLVolumeCutStorageNode.h"
 #include "vtkVolumeCutField.h"
 
 // MRML includes
@@ -137,6 +138,7 @@ void vtkSlicerVolumeCuttingLogic::RegisterNodes()
     return;
   }
   this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutNode>::New());
+  this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutStorageNode>::New());
 }
 
 //----------------------------------------------------------------------------
@@ -318,7 +320,7 @@ void vtkSlicerVolumeCuttingLogic::SetMRMLSceneInternal(vtkMRMLScene* newScene)
   events->InsertNextValue(vtkMRMLScene::NodeRemovedEvent);
   events->InsertNextValue(vtkMRMLScene::EndCloseEvent);
   this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
-  this->CutFields.clear();
+  this->ProtectionSources.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -326,14 +328,14 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
 {
   if (node && node->GetID())
   {
-    this->CutFields.erase(node->GetID());
+    this->ProtectionSources.erase(node->GetID());
   }
 }
 
 //----------------------------------------------------------------------------
 void vtkSlicerVolumeCuttingLogic::OnMRMLSceneEndClose()
 {
-  this->CutFields.clear();
+  this->ProtectionSources.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -356,7 +358,7 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
   vtkNew<vtkMatrix4x4> ijkToRas;
   anatomy->GetIJKToRASMatrix(ijkToRas);
 
-  vtkSmartPointer<vtkVolumeCutField>& field = this->CutFields[cutNode->GetID()];
+  vtkVolumeCutField* field = cutNode->GetCutField();
   bool matches = field != nullptr && field->GetSubVoxelFactor() == cutNode->GetSubVoxelFactor();
   if (matches)
   {
@@ -387,7 +389,6 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
     vtkNew<vtkVolumeCutField> newField;
     if (!newField->Initialize(anatomyDimensions, ijkToRas, cutNode->GetSubVoxelFactor()))
     {
-      this->CutFields.erase(cutNode->GetID());
       return nullptr;
     }
     if (field)
@@ -395,7 +396,7 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
       vtkWarningMacro("GetCutField: the anatomy grid or sub-voxel factor of '" << (cutNode->GetName() ? cutNode->GetName() : "")
                                                                                 << "' changed; its cut starts anew");
     }
-    this->CutFields[cutNode->GetID()] = newField;
+    cutNode->SetCutField(newField);
     this->ProtectionSources.erase(cutNode->GetID());
     this->UpdateProtection(cutNode, newField);
     return newField;

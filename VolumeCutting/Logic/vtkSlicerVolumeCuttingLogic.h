@@ -18,8 +18,6 @@
 #include <map>
 #include <string>
 
-// VTK includes
-#include <vtkSmartPointer.h>
 
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
 
@@ -71,8 +69,9 @@ public:
   /// Returns true when there is no error.
   bool CheckInputs(vtkMRMLVolumeCutNode* cutNode, vtkMRMLMessageCollection* messages);
 
-  /// The cut field of a cut node: created on first use on the anatomy's voxel
-  /// grid at the node's sub-voxel factor, and created anew (empty) when the
+  /// The cut field of a cut node (held by the node, saved with the scene):
+  /// created on first use on the anatomy's voxel grid at the node's sub-voxel
+  /// factor, and created anew (empty) when the
   /// anatomy's geometry or the factor changes. Its protection follows the
   /// node's protected segments (labels 1, 2, ... in the order of
   /// GetProtectedSegmentIDs), updated when they or the segmentation change.
@@ -145,9 +144,6 @@ protected:
   /// What the protection of each field was last built from.
   std::map<std::string, std::string> ProtectionSources;
 
-  /// Cut fields by cut-node ID. The logic owns them: the node stays a
-  /// parameter holder, the field is the Slicer-independent algorithm.
-  std::map<std::string, vtkSmartPointer<vtkVolumeCutField>> CutFields;
 };
 
 #endif

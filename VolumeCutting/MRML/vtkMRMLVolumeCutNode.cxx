@@ -9,6 +9,10 @@
 ==============================================================================*/
 
 #include "vtkMRMLVolumeCutNode.h"
+#include "vtkMRMLVolumeCutStorageNode.h"
+
+// VolumeCutting includes
+#include <vtkVolumeCutField.h>
 
 // MRML includes
 #include <vtkMRMLNodePropertyMacros.h>
@@ -86,7 +90,34 @@ vtkMRMLVolumeCutNode::vtkMRMLVolumeCutNode()
 }
 
 //----------------------------------------------------------------------------
-vtkMRMLVolumeCutNode::~vtkMRMLVolumeCutNode() = default;
+vtkMRMLVolumeCutNode::~vtkMRMLVolumeCutNode()
+{
+  vtkSetAndObserveMRMLObjectMacro(this->CutField, nullptr);
+}
+
+//----------------------------------------------------------------------------
+void vtkMRMLVolumeCutNode::SetCutField(vtkVolumeCutField* field)
+{
+  if (field == this->CutField)
+  {
+    return;
+  }
+  vtkSetAndObserveMRMLObjectMacro(this->CutField, field);
+  this->StorableModified();
+  this->Modified();
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLStorageNode* vtkMRMLVolumeCutNode::CreateDefaultStorageNode()
+{
+  return vtkMRMLVolumeCutStorageNode::New();
+}
+
+//----------------------------------------------------------------------------
+std::string vtkMRMLVolumeCutNode::GetDefaultStorageNodeClassName(const char* vtkNotUsed(filename))
+{
+  return "vtkMRMLVolumeCutStorageNode";
+}
 
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutNode::WriteXML(ostream& of, int nIndent)
@@ -118,6 +149,21 @@ void vtkMRMLVolumeCutNode::CopyContent(vtkMRMLNode* anode, bool deepCopy /*=true
 {
   MRMLNodeModifyBlocker blocker(this);
   Superclass::CopyContent(anode, deepCopy);
+  vtkMRMLVolumeCutNode* source = vtkMRMLVolumeCutNode::SafeDownCast(anode);
+  if (source)
+  {
+    if (deepCopy && source->GetCutField())
+    {
+      vtkNew<vtkVolumeCutField> field;
+      field->DeepCopy(source->GetCutField());
+      this->SetCutField(field);
+    }
+    else
+    {
+      // Shallow copies (scene undo) share the field: strokes have their own undo.
+      this->SetCutField(source->GetCutField());
+    }
+  }
   vtkMRMLCopyBeginMacro(anode);
   // Protected first, so that an ID moving from protected to cuttable in the
   // source is not rejected against this node's old protected list.
@@ -144,6 +190,12 @@ void vtkMRMLVolumeCutNode::ProcessMRMLEvents(vtkObject* caller, unsigned long ev
   Superclass::ProcessMRMLEvents(caller, event, callData);
   if (caller == nullptr)
   {
+    return;
+  }
+  if (caller == this->CutField && event == vtkCommand::ModifiedEvent)
+  {
+    // Cuts are data: the scene must save the node again.
+    this->StorableModified();
     return;
   }
   if (caller == this->GetSegmentationNode() && event == vtkSegmentation::SegmentRemoved)

@@ -12,7 +12,7 @@
 #define vtkMRMLVolumeCutNode_h
 
 // MRML includes
-#include <vtkMRMLNode.h>
+#include <vtkMRMLStorableNode.h>
 
 // STD includes
 #include <string>
@@ -22,6 +22,7 @@
 
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
+class vtkVolumeCutField;
 
 /// \brief Parameters of one volume-cutting session on one anatomy.
 ///
@@ -39,11 +40,11 @@ class vtkMRMLSegmentationNode;
 /// segmentation; when a segment is removed from it, its role is dropped.
 ///
 /// \sa vtkSlicerVolumeCuttingLogic
-class VTK_SLICER_VOLUMECUTTING_MODULE_MRML_EXPORT vtkMRMLVolumeCutNode : public vtkMRMLNode
+class VTK_SLICER_VOLUMECUTTING_MODULE_MRML_EXPORT vtkMRMLVolumeCutNode : public vtkMRMLStorableNode
 {
 public:
   static vtkMRMLVolumeCutNode* New();
-  vtkTypeMacro(vtkMRMLVolumeCutNode, vtkMRMLNode);
+  vtkTypeMacro(vtkMRMLVolumeCutNode, vtkMRMLStorableNode);
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   vtkMRMLNode* CreateNodeInstance() override;
@@ -64,6 +65,17 @@ public:
     /// Invoked when the role of any segment changes.
     SegmentRolesModifiedEvent
   };
+
+  ///@{
+  /// The removed region. The node holds it so that it is saved and read with
+  /// the scene (vtkMRMLVolumeCutStorageNode, .vcut); the logic creates it on
+  /// the anatomy's grid. Changes of the field mark the node modified for saving.
+  vtkVolumeCutField* GetCutField() { return this->CutField; }
+  void SetCutField(vtkVolumeCutField* field);
+  ///@}
+
+  vtkMRMLStorageNode* CreateDefaultStorageNode() override;
+  std::string GetDefaultStorageNodeClassName(const char* filename = nullptr) override;
 
   ///@{
   /// Anatomy volume (CT in Hounsfield units) the cut field is aligned with.
@@ -133,6 +145,7 @@ protected:
   static const char* SegmentationReferenceRole;
   static const char* ActiveToolReferenceRole;
 
+  vtkVolumeCutField* CutField{ nullptr };
   std::vector<std::string> CuttableSegmentIDs;
   std::vector<std::string> ProtectedSegmentIDs;
   int SubVoxelFactor{ 2 };

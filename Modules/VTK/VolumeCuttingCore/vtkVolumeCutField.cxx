@@ -19,6 +19,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <limits>
 #include <utility>
 
@@ -304,6 +306,7 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
   std::copy(dimensions, dimensions + 3, this->Dimensions);
   std::copy(brickDimensions, brickDimensions + 3, this->BrickDimensions);
   this->SubVoxelFactor = subVoxelFactor;
+  vtkMatrix4x4::DeepCopy(this->AnatomyIJKToRAS, anatomyIJKToRAS);
   for (int row = 0; row < 4; ++row)
   {
     for (int column = 0; column < 4; ++column)
@@ -1604,4 +1607,184 @@ void vtkVolumeCutField::ExtractRemovedSurface(vtkPolyData* surface) const
   toRas->SetTransform(subToRas);
   toRas->Update();
   surface->ShallowCopy(toRas->GetOutput());
+}
+
+namespace
+{
+// File layout, little-endian: magic, version, anatomy dimensions (3 x int32),
+// sub-voxel factor (int32), anatomy IJK-to-RAS (16 x float64), quantum
+// (float64), brick count (int64), then per brick its ID (int64) and its
+// samples (BrickSize^3 x int16). The band follows from the geometry.
+const char CutFieldMagic[8] = { 'V', 'C', 'U', 'T', 'F', 'L', 'D', '\0' };
+const int32_t CutFieldFileVersion = 1;
+
+template <typename T>
+void WriteValue(std::ofstream& stream, const T& value)
+{
+  stream.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+template <typename T>
+bool ReadValue(std::ifstream& stream, T& value)
+{
+  return static_cast<bool>(stream.read(reinterpret_cast<char*>(&value), sizeof(T)));
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::WriteFile(const char* fileName) const
+{
+  if (!fileName)
+  {
+    vtkErrorMacro("WriteFile: no file name");
+    return false;
+  }
+  std::ofstream stream(fileName, std::ios::binary | std::ios::trunc);
+  if (!stream)
+  {
+    vtkErrorMacro("WriteFile: cannot open " << fileName << " for writing");
+    return false;
+  }
+  // A field not initialized yet (nothing cut) is written with zero dimensions.
+  const int f = std::max(this->SubVoxelFactor, 1);
+  stream.write(CutFieldMagic, sizeof(CutFieldMagic));
+  WriteValue(stream, CutFieldFileVersion);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    WriteValue(stream, static_cast<int32_t>(this->Dimensions[axis] / f));
+  }
+  WriteValue(stream, static_cast<int32_t>(f));
+  for (double element : this->AnatomyIJKToRAS)
+  {
+    WriteValue(stream, element);
+  }
+  WriteValue(stream, this->Quantum);
+  const vtkIdType count = this->Directory ? this->NumberOfAllocatedBricks.load(std::memory_order_acquire) : 0;
+  WriteValue(stream, static_cast<int64_t>(count));
+  short values[SamplesPerBrick];
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    this->CopyBrick(brickId, values);
+    WriteValue(stream, static_cast<int64_t>(brickId));
+    stream.write(reinterpret_cast<const char*>(values), sizeof(values));
+  }
+  if (!stream.flush())
+  {
+    vtkErrorMacro("WriteFile: writing " << fileName << " failed");
+    return false;
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ReadFile(const char* fileName)
+{
+  std::ifstream stream(fileName ? fileName : "", std::ios::binary);
+  if (!fileName || !stream)
+  {
+    vtkErrorMacro("ReadFile: cannot open " << (fileName ? fileName : "(no file name)"));
+    return false;
+  }
+  char magic[sizeof(CutFieldMagic)];
+  int32_t version = 0;
+  if (!stream.read(magic, sizeof(magic)) || std::memcmp(magic, CutFieldMagic, sizeof(magic)) != 0 || !ReadValue(stream, version)
+      || version != CutFieldFileVersion)
+  {
+    vtkErrorMacro("ReadFile: " << fileName << " is not a cut field file of version " << CutFieldFileVersion);
+    return false;
+  }
+  int32_t anatomyDimensions[3];
+  int32_t factor = 0;
+  double matrixElements[16];
+  double quantum = 0.0;
+  int64_t count = 0;
+  bool ok = ReadValue(stream, anatomyDimensions[0]) && ReadValue(stream, anatomyDimensions[1]) && ReadValue(stream, anatomyDimensions[2])
+    && ReadValue(stream, factor);
+  for (double& element : matrixElements)
+  {
+    ok = ok && ReadValue(stream, element);
+  }
+  ok = ok && ReadValue(stream, quantum) && ReadValue(stream, count);
+  if (!ok)
+  {
+    vtkErrorMacro("ReadFile: " << fileName << " is truncated");
+    return false;
+  }
+  if (anatomyDimensions[0] == 0 && anatomyDimensions[1] == 0 && anatomyDimensions[2] == 0 && count == 0)
+  {
+    vtkNew<vtkVolumeCutField> empty;
+    this->DeepCopy(empty); // a field that was never initialized
+    return true;
+  }
+  vtkNew<vtkVolumeCutField> loaded;
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  ijkToRas->DeepCopy(matrixElements);
+  const int dimensions[3] = { anatomyDimensions[0], anatomyDimensions[1], anatomyDimensions[2] };
+  if (!loaded->Initialize(dimensions, ijkToRas, factor))
+  {
+    vtkErrorMacro("ReadFile: " << fileName << " holds an invalid geometry");
+    return false;
+  }
+  const vtkIdType totalBricks = static_cast<vtkIdType>(loaded->BrickDimensions[0]) * loaded->BrickDimensions[1] * loaded->BrickDimensions[2];
+  if (std::abs(quantum - loaded->Quantum) > 1e-12 * std::max(1.0, loaded->Quantum) || count < 0 || count > totalBricks)
+  {
+    vtkErrorMacro("ReadFile: " << fileName << " is inconsistent (quantum or brick count)");
+    return false;
+  }
+  std::vector<std::pair<vtkIdType, BrickValues>> bricks;
+  bricks.reserve(static_cast<size_t>(count));
+  for (int64_t n = 0; n < count; ++n)
+  {
+    int64_t brickId = -1;
+    BrickValues values(SamplesPerBrick);
+    if (!ReadValue(stream, brickId) || !stream.read(reinterpret_cast<char*>(values.data()), SamplesPerBrick * sizeof(int16_t)))
+    {
+      vtkErrorMacro("ReadFile: " << fileName << " is truncated (brick " << n << " of " << count << ")");
+      return false;
+    }
+    if (brickId < 0 || brickId >= totalBricks)
+    {
+      vtkErrorMacro("ReadFile: " << fileName << " names a brick outside the volume");
+      return false;
+    }
+    bricks.emplace_back(static_cast<vtkIdType>(brickId), std::move(values));
+  }
+  loaded->WriteBricks(bricks);
+  this->DeepCopy(loaded);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::DeepCopy(vtkVolumeCutField* source)
+{
+  if (!source || source == this)
+  {
+    return;
+  }
+  if (!source->Directory)
+  {
+    this->Reset();
+    std::fill(this->Dimensions, this->Dimensions + 3, 0);
+    this->SubVoxelFactor = 0;
+    this->Modified();
+    return;
+  }
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  ijkToRas->DeepCopy(source->AnatomyIJKToRAS);
+  const int f = source->SubVoxelFactor;
+  const int dimensions[3] = { source->Dimensions[0] / f, source->Dimensions[1] / f, source->Dimensions[2] / f };
+  this->Initialize(dimensions, ijkToRas, f);
+  this->MaximumStrokeLength = source->MaximumStrokeLength;
+  this->UndoMemoryBudget = source->UndoMemoryBudget;
+  std::vector<std::pair<vtkIdType, BrickValues>> bricks;
+  const vtkIdType count = source->GetNumberOfAllocatedBricks();
+  short values[SamplesPerBrick];
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    source->CopyBrick(brickId, values);
+    bricks.emplace_back(brickId, BrickValues(values, values + SamplesPerBrick));
+  }
+  this->WriteBricks(bricks);
 }

@@ -70,6 +70,22 @@ public:
    */
   bool Initialize(const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int subVoxelFactor);
 
+  /**
+   * Write the field (geometry, band and every allocated brick; not the undo
+   * history or the protection, which follow from the session) to a file.
+   * Returns false and logs an error if it cannot be written.
+   */
+  bool WriteFile(const char* fileName) const;
+
+  /**
+   * Read a field written by WriteFile. A missing, truncated, corrupt or
+   * foreign file is refused with an error and leaves this field as it was.
+   */
+  bool ReadFile(const char* fileName);
+
+  /// Make this field a copy of another: geometry and samples, not history.
+  void DeepCopy(vtkVolumeCutField* source);
+
   ///@{
   /**
    * Geometry of the sub-voxel grid (valid after Initialize).
@@ -302,6 +318,7 @@ protected:
   double HalfDiagonal = 0.5;
   double MaximumStrokeLength = 50.0;
   double SubIJKToRAS[4][4];
+  double AnatomyIJKToRAS[16];
   double RASToSubIJK[4][4];
   size_t UndoMemoryBudget = 256u << 20;
   size_t UndoMemorySize = 0;

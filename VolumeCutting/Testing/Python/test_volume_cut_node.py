@@ -94,6 +94,10 @@ def test_save_scene_file_and_reload(scene, tmp_path):
     cut.SetSegmentCuttable(logic.GetTrabecularBoneSegmentID(), True)
     cut.SetSegmentProtected(logic.GetCorticalBoneSegmentID(), True)
     cut.SetSubVoxelFactor(4)
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    assert logic.CutSphereSweep(cut, center, [center[0] + 2.0, center[1], center[2]], 1.5)
+    removed = logic.GetRemovedVolume(cut)
+    assert removed > 10.0
 
     bundle = tmp_path / "session.mrb"
     assert scene.WriteToMRB(str(bundle))
@@ -116,6 +120,10 @@ def test_save_scene_file_and_reload(scene, tmp_path):
     assert read_bone is not None
     assert read_bone.GetSegmentation().GetNumberOfSegments() == 2
     assert logic.CheckInputs(read, slicer.vtkMRMLMessageCollection())
+    # The cut came back with the scene, on the same grid.
+    assert read.GetCutField() is not None
+    assert read.GetCutField().ComputeRemovedVolume() == pytest.approx(removed, rel=1e-9)
+    assert reloaded.volume_cutting_logic.GetRemovedVolume(read) == pytest.approx(removed, rel=1e-9)
 
 
 def test_mrml_text_round_trip(scene, tmp_path):

@@ -195,3 +195,29 @@ def test_mesh_tool_and_its_refusals():
     bad.SetRadius(-1.0)
     assert not field.CutToolSweep(bad, at, at)
     assert field.ComputeRemovedVolume() == before
+
+
+def test_file_round_trip_and_corrupt_files(tmp_path):
+    field = fresh_field(dims=(30, 30, 30))
+    field.CutCapsule([5.0, 5.0, 5.0], [9.0, 7.0, 6.0], 2.0)
+    path = tmp_path / "cut.vcut"
+    assert field.WriteFile(str(path))
+    copy = slicer.vtkVolumeCutField()
+    assert copy.ReadFile(str(path))
+    assert copy.ComputeRemovedVolume() == pytest.approx(field.ComputeRemovedVolume(), rel=1e-12)
+    assert copy.GetSignedDistance([7.0, 6.0, 5.5]) == pytest.approx(field.GetSignedDistance([7.0, 6.0, 5.5]))
+
+    data = path.read_bytes()
+    truncated = tmp_path / "truncated.vcut"
+    truncated.write_bytes(data[: len(data) // 2])
+    foreign = tmp_path / "foreign.vcut"
+    foreign.write_bytes(b"not a cut field at all" * 10)
+    for bad in (truncated, foreign, tmp_path / "missing.vcut"):
+        assert not copy.ReadFile(str(bad))
+        assert copy.ComputeRemovedVolume() == pytest.approx(field.ComputeRemovedVolume(), rel=1e-12)
+
+    # A field that never cut round-trips as "nothing yet".
+    empty = tmp_path / "empty.vcut"
+    assert slicer.vtkVolumeCutField().WriteFile(str(empty))
+    assert copy.ReadFile(str(empty))
+    assert copy.GetDimensions() == (0, 0, 0)
