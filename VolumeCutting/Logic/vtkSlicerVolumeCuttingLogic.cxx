@@ -505,6 +505,20 @@ bool vtkSlicerVolumeCuttingLogic::RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNo
 }
 
 //----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->CutToolSweep(tool, pose0, pose1);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  return field && field->RestoreToolSweep(tool, pose0, pose1);
+}
+
+//----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);

@@ -26,7 +26,9 @@ class vtkMRMLModelNode;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
+class vtkMatrix4x4;
 class vtkVolumeCutField;
+class vtkVolumeCutTool;
 
 /// \brief Builds and checks volume-cutting sessions.
 ///
@@ -88,6 +90,10 @@ public:
   bool CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);
   bool RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);
   bool EndStroke(vtkMRMLVolumeCutNode* cutNode);
+  /// Any tool (cylinder, ellipsoid, blade, mesh, sawing prism) moving rigidly
+  /// from pose0 to pose1 (tool-to-RAS).
+  bool CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+  bool RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
   bool UndoStroke(vtkMRMLVolumeCutNode* cutNode);
   bool RedoStroke(vtkMRMLVolumeCutNode* cutNode);
   ///@}

@@ -1,6 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutFieldDistanceSource.h"
 
 #include "vtkDataArray.h"
 #include "vtkFlyingEdges3D.h"
@@ -600,22 +601,6 @@ void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick
   }
   this->StrokeBefore.emplace(brickId, std::move(values));
 }
-
-//------------------------------------------------------------------------------
-/// What ApplyDistance needs to know of a tool sweep: where it reaches and its
-/// signed distance (mm, negative inside), per grid row or at a point.
-struct vtkVolumeCutField::DistanceSource
-{
-  virtual ~DistanceSource() = default;
-  /// RAS box holding every point within reach (the swept tool grown by the band).
-  virtual void GetReachBounds(double lower[3], double upper[3]) const = 0;
-  /// Stretch [first, last] (row index units) of the row origin + t * step within reach.
-  virtual bool RowInterval(const double origin[3], double& first, double& last) const = 0;
-  /// Distances at t = first .. last into distances[0 .. last - first].
-  virtual void RowDistances(const double origin[3], int first, int last, float* distances) const = 0;
-  /// Distance at one point (contacts).
-  virtual double Distance(const double point[3]) const = 0;
-};
 
 namespace
 {

@@ -347,6 +347,7 @@ protected:
   std::vector<UndoStep> RedoStack;
 
 private:
+  friend class vtkVolumeCutMaterialRemoval;
   vtkVolumeCutField(const vtkVolumeCutField&) = delete;
   void operator=(const vtkVolumeCutField&) = delete;
 };

@@ -221,3 +221,78 @@ def test_file_round_trip_and_corrupt_files(tmp_path):
     assert slicer.vtkVolumeCutField().WriteFile(str(empty))
     assert copy.ReadFile(str(empty))
     assert copy.GetDimensions() == (0, 0, 0)
+
+
+def test_sawing_extrudes_a_drawn_polygon_to_a_depth():
+    # An L-shaped (concave) outline drawn on the view, sawn 6 mm deep along
+    # the viewing direction (here the tilted local z).
+    saw = slicer.vtkVolumeCutPrismTool()
+    for x, y in [(0.0, 0.0), (8.0, 0.0), (8.0, 3.0), (3.0, 3.0), (3.0, 7.0), (0.0, 7.0)]:
+        saw.AddVertex(x - 4.0, y - 3.5)
+    saw.SetDepth(6.0)
+    assert saw.IsValid()
+    field = fresh_field()
+    view = pose([15.0, 15.0, 12.0], axis=(1.0, 0.0, 0.0), degrees=20.0)
+    assert field.CutToolSweep(saw, view, view)
+    area = 8.0 * 3.0 + 3.0 * 4.0
+    assert abs(field.ComputeRemovedVolume() - area * 6.0) / (area * 6.0) < 0.01
+    # The notch of the L is not sawn.
+    notch = vtk.vtkMatrix4x4()
+    notch.DeepCopy(view)
+    local_notch = [6.0 - 4.0, 5.0 - 3.5, 3.0, 1.0]
+    assert field.GetSignedDistance(notch.MultiplyPoint(local_notch)[:3]) > 0.0
+
+    degenerate = slicer.vtkVolumeCutPrismTool()
+    degenerate.AddVertex(0.0, 0.0)
+    degenerate.AddVertex(1.0, 1.0)
+    assert not degenerate.IsValid()
+    assert not field.CutToolSweep(degenerate, view, view)
+
+
+def hu_block(dims, value_left, value_right):
+    """A CT whose x < middle half has one HU value and the other half another."""
+    voxels = np.full((dims[2], dims[1], dims[0]), value_right, dtype=np.int16)
+    voxels[:, :, : dims[0] // 2] = value_left
+    image = vtk.vtkImageData()
+    image.SetDimensions(*dims)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(voxels.ravel(), deep=True, array_type=vtk.VTK_SHORT))
+    return image
+
+
+def drill_for(seconds, hu_value, burr_type=0, steps=20):
+    dims = (40, 40, 40)
+    field = fresh_field(dims=dims)
+    remover = slicer.vtkVolumeCutMaterialRemoval()
+    remover.SetBurrType(burr_type)
+    assert remover.SetInputs(field, hu_block(dims, hu_value, hu_value))
+    for _ in range(steps):
+        # A 2 mm burr pressed sideways (axis along z) into the block.
+        assert remover.Drill([10.0, 10.0, 10.0], [0.0, 0.0, 1.0], 2.0, seconds / steps)
+    return field.ComputeRemovedVolume()
+
+
+def test_material_removal_follows_time_density_and_burr():
+    trabecular = [drill_for(t, 450) for t in (0.05, 0.1, 0.2, 0.4)]
+    # More time removes more, up to the burr's own volume.
+    assert all(a <= b for a, b in zip(trabecular, trabecular[1:]))
+    assert trabecular[0] < trabecular[-1] <= 4.0 / 3.0 * math.pi * 8.0 * 1.01
+    # Cortical bone takes longer than trabecular bone, but gives way in the end.
+    assert 0.0 < drill_for(0.4, 1500) < drill_for(0.4, 450)
+    assert drill_for(2.0, 1500) == pytest.approx(drill_for(2.0, 450), rel=0.05)
+    # A diamond burr removes less than a cutting burr in the same time.
+    assert 0.0 < drill_for(0.2, 450, burr_type=1) < drill_for(0.2, 450, burr_type=0)
+    # Deterministic: the same inputs give the same cut.
+    assert drill_for(0.1, 450) == drill_for(0.1, 450)
+
+
+def test_material_removal_refuses_bad_input():
+    dims = (20, 20, 20)
+    field = fresh_field(dims=dims)
+    remover = slicer.vtkVolumeCutMaterialRemoval()
+    assert not remover.Drill([5.0, 5.0, 5.0], [0.0, 0.0, 1.0], 1.0, 0.1)  # no inputs
+    assert not remover.SetInputs(field, hu_block((10, 10, 10), 400, 400))  # wrong size
+    assert remover.SetInputs(field, hu_block(dims, 400, 400))
+    assert not remover.Drill([5.0, float("nan"), 5.0], [0.0, 0.0, 1.0], 1.0, 0.1)
+    assert not remover.Drill([5.0, 5.0, 5.0], [0.0, 0.0, 0.0], 1.0, 0.1)
+    assert not remover.Drill([5.0, 5.0, 5.0], [0.0, 0.0, 1.0], 1.0, -0.1)
+    assert field.ComputeRemovedVolume() == 0.0
