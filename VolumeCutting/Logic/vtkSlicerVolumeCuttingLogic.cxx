@@ -406,10 +406,38 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
 }
 
 //----------------------------------------------------------------------------
+std::vector<std::string> vtkSlicerVolumeCuttingLogic::GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode)
+{
+  // Tool sensibility: a tool affects only cuttable segments. The others are
+  // shielded: first the ones without a role, then the protected ones, so that
+  // where segments overlap a protected one names the voxel.
+  std::vector<std::string> shielded;
+  vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
+  if (!segmentationNode)
+  {
+    return shielded;
+  }
+  std::vector<std::string> segmentIds;
+  segmentationNode->GetSegmentation()->GetSegmentIDs(segmentIds);
+  for (const std::string& id : segmentIds)
+  {
+    if (!cutNode->IsSegmentCuttable(id) && !cutNode->IsSegmentProtected(id))
+    {
+      shielded.push_back(id);
+    }
+  }
+  for (const std::string& id : cutNode->GetProtectedSegmentIDs())
+  {
+    shielded.push_back(id);
+  }
+  return shielded;
+}
+
+//----------------------------------------------------------------------------
 void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field)
 {
   vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
-  const std::vector<std::string> protectedIds = cutNode->GetProtectedSegmentIDs();
+  const std::vector<std::string> protectedIds = GetShieldedSegmentIDs(cutNode);
   std::ostringstream source;
   if (segmentationNode)
   {
@@ -419,6 +447,7 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
   {
     source << "|" << id;
   }
+  source << "#" << protectedIds.size();
   std::string& last = this->ProtectionSources[cutNode->GetID()];
   if (last == source.str())
   {
@@ -447,7 +476,7 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
         || !segmentationNode->GetBinaryLabelmapRepresentation(protectedIds[index], segmentMask)
         || !vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
     {
-      vtkWarningMacro("UpdateProtection: protected segment '" << protectedIds[index] << "' has no labelmap on the anatomy grid; it is not protected");
+      vtkWarningMacro("UpdateProtection: segment '" << protectedIds[index] << "' has no labelmap on the anatomy grid; tools are not kept out of it");
       continue;
     }
     int extent[6];
@@ -473,7 +502,7 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
 std::string vtkSlicerVolumeCuttingLogic::GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  const std::vector<std::string> protectedIds = cutNode ? cutNode->GetProtectedSegmentIDs() : std::vector<std::string>();
+  const std::vector<std::string> protectedIds = GetShieldedSegmentIDs(cutNode);
   const int label = field ? field->GetContactLabel() : 0;
   return label > 0 && label <= static_cast<int>(protectedIds.size()) ? protectedIds[label - 1] : std::string();
 }

@@ -17,6 +17,7 @@
 // STD includes
 #include <map>
 #include <string>
+#include <vector>
 
 
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
@@ -110,8 +111,9 @@ public:
   /// nullptr and an error if the node has no cut field.
   vtkMRMLSegmentationNode* ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
 
-  /// The protected segment a tool touched most deeply since the last
-  /// ResetContact of the node's field ("" if none), and how deep (mm).
+  /// The segment kept out of cutting (protected, or without a role) that a tool
+  /// touched most deeply since the last ResetContact of the node's field ("" if
+  /// none); the field gives the depth (mm) and position.
   std::string GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode);
 
   /// Add a model of the removed region's closed boundary, contoured at
@@ -144,7 +146,10 @@ protected:
   void OnMRMLSceneEndClose() override;
   void SetMRMLSceneInternal(vtkMRMLScene* newScene) override;
 
-  /// Give the field the node's protected segments as labels on the anatomy grid.
+  /// Segments kept out of cutting, in label order (label n is element n - 1).
+  static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
+
+  /// Give the field the node's shielded segments as labels on the anatomy grid.
   void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
 
   /// What the protection of each field was last built from.

@@ -35,6 +35,9 @@ class vtkVolumeCutField;
 /// a separate cut field (multivolume scheme of Pflesser et al., 2002), so the
 /// node only references the anatomy.
 ///
+/// Tool sensibility: tools remove only cuttable segments (and voxels outside
+/// every segment). Protected segments are the critical structures whose
+/// contact matters; segments without a role are left alone too.
 /// A segment has at most one role: setting a segment cuttable clears its
 /// protected role and vice versa. Roles refer to segment IDs of the referenced
 /// segmentation; when a segment is removed from it, its role is dropped.

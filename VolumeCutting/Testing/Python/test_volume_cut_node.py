@@ -200,6 +200,7 @@ def test_exports_of_the_removed_region(scene, tmp_path):
     logic = scene.volumeCuttingLogic
     bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
     cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
     center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
     assert logic.CutSphereSweep(cut, center, center, 2.0)
     removed = logic.GetRemovedVolume(cut)
@@ -226,3 +227,18 @@ def test_exports_of_the_removed_region(scene, tmp_path):
     counted = numpy_support.vtk_to_numpy(labelmap.GetPointData().GetScalars()).astype(bool).sum()
     voxel = 0.6 * 0.6 * 1.0
     assert abs(counted * voxel - removed) / removed < 0.15
+
+
+def test_tools_affect_only_cuttable_segments(scene):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    # No role yet: the trabecular ball is not the tool's to cut.
+    assert logic.CutSphereSweep(cut, center, center, 2.0)
+    assert logic.GetRemovedVolume(cut) < 0.01
+    assert logic.GetContactSegmentID(cut) == logic.GetTrabecularBoneSegmentID()
+    cut.SetSegmentCuttable(logic.GetTrabecularBoneSegmentID(), True)
+    assert logic.CutSphereSweep(cut, center, center, 2.0)
+    assert logic.GetRemovedVolume(cut) > 30.0

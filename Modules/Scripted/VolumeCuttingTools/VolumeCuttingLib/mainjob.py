@@ -28,7 +28,8 @@ from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
 # the structures whose injury is the complication the trainee must avoid.
-PHANTOM_CUTTABLE_SEGMENTS = ("MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
+# The skin and soft tissue over the mastoid are incised and reflected first.
+PHANTOM_CUTTABLE_SEGMENTS = ("SoftTissue", "MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
 PHANTOM_PROTECTED_SEGMENTS = (
     "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
 

@@ -240,6 +240,9 @@ int TestStrokesAndRemovedVolumePerSegment()
   double center[4];
   ijkToRas->MultiplyPoint(centerIjk, center);
 
+  // Tools affect only cuttable segments.
+  cutNode->SetCuttableSegmentIDs({ vtkSlicerVolumeCuttingLogic::GetCorticalBoneSegmentID(), vtkSlicerVolumeCuttingLogic::GetTrabecularBoneSegmentID() });
+
   // A 2 mm burr at the centre stays inside the trabecular ball (semi-axes 3, 3, 4.8 mm).
   CHECK_BOOL(logic->BeginStroke(cutNode), true);
   CHECK_BOOL(logic->CutSphereSweep(cutNode, center, center, 2.0), true);
