@@ -1412,13 +1412,9 @@ double vtkVolumeCutField::GetRemovedFraction(int i, int j, int k) const
 }
 
 //------------------------------------------------------------------------------
-double vtkVolumeCutField::ComputeRemovedVolume() const
+template <typename Visitor>
+void vtkVolumeCutField::ForEachAllocatedSample(Visitor&& visit) const
 {
-  if (!this->Directory)
-  {
-    return 0.0;
-  }
-  double removed = 0.0;
   const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
   for (vtkIdType n = 0; n < count; ++n)
   {
@@ -1432,11 +1428,22 @@ double vtkVolumeCutField::ComputeRemovedVolume() const
       {
         for (int i = bi * BrickSize; i < std::min((bi + 1) * BrickSize, this->Dimensions[0]); ++i)
         {
-          removed += this->GetRemovedFraction(i, j, k);
+          visit(i, j, k);
         }
       }
     }
   }
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::ComputeRemovedVolume() const
+{
+  if (!this->Directory)
+  {
+    return 0.0;
+  }
+  double removed = 0.0;
+  this->ForEachAllocatedSample([&](int i, int j, int k) { removed += this->GetRemovedFraction(i, j, k); });
   const double subVoxelVolume = std::abs(vtkMatrix4x4::Determinant(&this->SubIJKToRAS[0][0]));
   return removed * subVoxelVolume;
 }
@@ -1464,28 +1471,13 @@ void vtkVolumeCutField::ExportRemovedFraction(vtkImageData* anatomyFraction) con
   }
   float* fractions = scalars->GetPointer(0);
   const double perSubVoxel = 1.0 / (f * f * f);
-  const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
-  for (vtkIdType n = 0; n < count; ++n)
-  {
-    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
-    const int bi = static_cast<int>(brickId % this->BrickDimensions[0]);
-    const int bj = static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]);
-    const int bk = static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1]));
-    for (int k = bk * BrickSize; k < std::min((bk + 1) * BrickSize, this->Dimensions[2]); ++k)
+  this->ForEachAllocatedSample([&](int i, int j, int k) {
+    const double fraction = this->GetRemovedFraction(i, j, k);
+    if (fraction > 0.0)
     {
-      for (int j = bj * BrickSize; j < std::min((bj + 1) * BrickSize, this->Dimensions[1]); ++j)
-      {
-        for (int i = bi * BrickSize; i < std::min((bi + 1) * BrickSize, this->Dimensions[0]); ++i)
-        {
-          const double fraction = this->GetRemovedFraction(i, j, k);
-          if (fraction > 0.0)
-          {
-            fractions[(static_cast<vtkIdType>(k / f) * dims[1] + j / f) * dims[0] + i / f] += static_cast<float>(fraction * perSubVoxel);
-          }
-        }
-      }
+      fractions[(static_cast<vtkIdType>(k / f) * dims[1] + j / f) * dims[0] + i / f] += static_cast<float>(fraction * perSubVoxel);
     }
-  }
+  });
 }
 
 //------------------------------------------------------------------------------

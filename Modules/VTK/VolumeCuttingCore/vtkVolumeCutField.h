@@ -307,6 +307,9 @@ protected:
   void WriteBricks(const std::vector<std::pair<vtkIdType, BrickValues>>& bricks);
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
+  /// Calls visit(i, j, k) for every sample of every allocated brick.
+  template <typename Visitor>
+  void ForEachAllocatedSample(Visitor&& visit) const;
   void Reset();
   const ProtectionBrick* GetProtectionBrick(vtkIdType brickId) const;
 
