@@ -520,30 +520,40 @@ bool vtkSlicerVolumeCuttingLogic::BeginStroke(vtkMRMLVolumeCutNode* cutNode)
 }
 
 //----------------------------------------------------------------------------
+vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetStrokeField(vtkMRMLVolumeCutNode* cutNode)
+{
+  // Inside a stroke the field was checked at BeginStroke (grid, factor,
+  // protection): the poses of a haptic device, a thousand a second, go
+  // straight to it.
+  vtkVolumeCutField* field = cutNode ? cutNode->GetCutField() : nullptr;
+  return field && field->IsStrokeOpen() ? field : this->GetCutField(cutNode);
+}
+
+//----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
   return field && field->CutCapsule(p0, p1, radius);
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
   return field && field->RestoreCapsule(p0, p1, radius);
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
   return field && field->CutToolSweep(tool, pose0, pose1);
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
   return field && field->RestoreToolSweep(tool, pose0, pose1);
 }
 

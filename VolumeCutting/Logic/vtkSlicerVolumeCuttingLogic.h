@@ -146,6 +146,9 @@ protected:
   void OnMRMLSceneEndClose() override;
   void SetMRMLSceneInternal(vtkMRMLScene* newScene) override;
 
+  /// The field for one pose: checked once per stroke, not per pose.
+  vtkVolumeCutField* GetStrokeField(vtkMRMLVolumeCutNode* cutNode);
+
   /// Segments kept out of cutting, in label order (label n is element n - 1).
   static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
 
