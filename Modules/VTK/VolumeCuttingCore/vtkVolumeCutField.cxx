@@ -284,9 +284,14 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
     brickDimensions[axis] = (dimensions[axis] + BrickSize - 1) / BrickSize;
     brickCount *= brickDimensions[axis];
   }
-  if (brickCount > static_cast<double>(std::numeric_limits<int32_t>::max()))
+  // The brick directory is dense (two words per brick): refuse grids whose
+  // directory alone would take more than 1 GiB instead of failing to allocate.
+  const double directoryBytes = brickCount * (sizeof(std::atomic<Brick*>) + sizeof(std::atomic<vtkIdType>));
+  if (brickCount > static_cast<double>(std::numeric_limits<int32_t>::max()) || directoryBytes > static_cast<double>(1u << 30))
   {
-    vtkErrorMacro("Initialize: the volume is too large for a cut field (" << brickCount << " bricks)");
+    vtkErrorMacro("Initialize: " << anatomyDimensions[0] << " x " << anatomyDimensions[1] << " x " << anatomyDimensions[2]
+                                 << " voxels at sub-voxel factor " << subVoxelFactor << " is too large for a cut field ("
+                                 << directoryBytes / (1u << 20) << " MiB of brick directory); use a lower factor or crop the volume");
     return false;
   }
 

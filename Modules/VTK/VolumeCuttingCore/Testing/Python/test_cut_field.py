@@ -296,3 +296,13 @@ def test_material_removal_refuses_bad_input():
     assert not remover.Drill([5.0, 5.0, 5.0], [0.0, 0.0, 0.0], 1.0, 0.1)
     assert not remover.Drill([5.0, 5.0, 5.0], [0.0, 0.0, 1.0], 1.0, -0.1)
     assert field.ComputeRemovedVolume() == 0.0
+
+
+def test_a_huge_volume_is_refused_not_allocated():
+    field = fresh_field(dims=(20, 20, 20))
+    field.CutCapsule([5.0, 5.0, 5.0], [5.0, 5.0, 5.0], 2.0)
+    before = field.ComputeRemovedVolume()
+    assert not field.Initialize([4096, 4096, 4096], vtk.vtkMatrix4x4(), 4)
+    assert field.ComputeRemovedVolume() == before
+    # 512^3 at factor 4 is within bounds (2^24 bricks, 256 MiB of directory).
+    assert slicer.vtkVolumeCutField().Initialize([512, 512, 512], vtk.vtkMatrix4x4(), 4)
