@@ -15,6 +15,7 @@
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkMRMLVolumeCutStorageNode.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutMaterialRemoval.h"
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
@@ -321,6 +322,7 @@ void vtkSlicerVolumeCuttingLogic::SetMRMLSceneInternal(vtkMRMLScene* newScene)
   events->InsertNextValue(vtkMRMLScene::EndCloseEvent);
   this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
   this->ProtectionSources.clear();
+  this->MaterialRemovals.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -329,6 +331,7 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
   if (node && node->GetID())
   {
     this->ProtectionSources.erase(node->GetID());
+    this->MaterialRemovals.erase(node->GetID());
   }
 }
 
@@ -336,6 +339,7 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
 void vtkSlicerVolumeCuttingLogic::OnMRMLSceneEndClose()
 {
   this->ProtectionSources.clear();
+  this->MaterialRemovals.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -733,4 +737,38 @@ vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportDrilledVolume(vtkMRM
   volume->SetAndObserveImageData(drilled);
   volume->CreateDefaultDisplayNodes();
   return volume;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::DrillWithMaterialRemoval(vtkMRMLVolumeCutNode* cutNode, const double center[3], const double axis[3], double radius,
+                                                           double dt, int burrType)
+{
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
+  vtkMRMLScalarVolumeNode* anatomy = cutNode ? cutNode->GetAnatomyVolumeNode() : nullptr;
+  if (!field || !anatomy || !anatomy->GetImageData())
+  {
+    vtkErrorMacro("DrillWithMaterialRemoval: the cut node needs an anatomy volume with voxels");
+    return false;
+  }
+  vtkSmartPointer<vtkVolumeCutMaterialRemoval>& remover = this->MaterialRemovals[cutNode->GetID()];
+  if (!remover)
+  {
+    remover = vtkSmartPointer<vtkVolumeCutMaterialRemoval>::New();
+  }
+  // New inputs (a new field or anatomy) restart the exposure.
+  if (!remover->SetInputsIfChanged(field, anatomy->GetImageData()))
+  {
+    return false;
+  }
+  remover->SetBurrType(burrType);
+  return remover->Drill(center, axis, radius, dt);
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::ResetMaterialRemoval(vtkMRMLVolumeCutNode* cutNode)
+{
+  if (cutNode && cutNode->GetID())
+  {
+    this->MaterialRemovals.erase(cutNode->GetID());
+  }
 }

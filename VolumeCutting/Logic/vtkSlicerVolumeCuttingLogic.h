@@ -19,6 +19,9 @@
 #include <string>
 #include <vector>
 
+// VTK includes
+#include <vtkSmartPointer.h>
+
 
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
 
@@ -29,6 +32,7 @@ class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
 class vtkMatrix4x4;
 class vtkVolumeCutField;
+class vtkVolumeCutMaterialRemoval;
 class vtkVolumeCutTool;
 
 /// \brief Builds and checks volume-cutting sessions.
@@ -95,6 +99,12 @@ public:
   /// from pose0 to pose1 (tool-to-RAS).
   bool CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
   bool RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+  /// Drill for dt seconds with rate-based material removal (seed 003): the
+  /// node's anatomy gives bone density in HU; burrType is
+  /// vtkVolumeCutMaterialRemoval::CuttingBurr or DiamondBurr. Exposure
+  /// accumulates per node until ResetMaterialRemoval or a new cut field.
+  bool DrillWithMaterialRemoval(vtkMRMLVolumeCutNode* cutNode, const double center[3], const double axis[3], double radius, double dt, int burrType);
+  void ResetMaterialRemoval(vtkMRMLVolumeCutNode* cutNode);
   bool UndoStroke(vtkMRMLVolumeCutNode* cutNode);
   bool RedoStroke(vtkMRMLVolumeCutNode* cutNode);
   ///@}
@@ -154,6 +164,9 @@ protected:
 
   /// Give the field the node's shielded segments as labels on the anatomy grid.
   void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
+
+  /// Rate-based removal state per cut-node ID (its field and anatomy are inputs).
+  std::map<std::string, vtkSmartPointer<vtkVolumeCutMaterialRemoval>> MaterialRemovals;
 
   /// What the protection of each field was last built from.
   std::map<std::string, std::string> ProtectionSources;

@@ -188,6 +188,16 @@ bool vtkVolumeCutMaterialRemoval::SetInputs(vtkVolumeCutField* field, vtkImageDa
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutMaterialRemoval::SetInputsIfChanged(vtkVolumeCutField* field, vtkImageData* hounsfieldUnits)
+{
+  if (field && field == this->Field && hounsfieldUnits == this->HounsfieldUnits)
+  {
+    return true;
+  }
+  return this->SetInputs(field, hounsfieldUnits);
+}
+
+//------------------------------------------------------------------------------
 void vtkVolumeCutMaterialRemoval::ResetExposure()
 {
   this->Exposure.clear();

@@ -74,6 +74,10 @@ public:
    */
   bool SetInputs(vtkVolumeCutField* field, vtkImageData* hounsfieldUnits);
 
+  /// SetInputs only if either input differs from the current ones (keeps the
+  /// exposure otherwise).
+  bool SetInputsIfChanged(vtkVolumeCutField* field, vtkImageData* hounsfieldUnits);
+
   /**
    * Drill for dt seconds with a spherical burr of the given radius (mm) at
    * center, its shaft along axis (RAS). Returns false (and an error), changing

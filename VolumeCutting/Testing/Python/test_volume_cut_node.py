@@ -242,3 +242,53 @@ def test_tools_affect_only_cuttable_segments(scene):
     cut.SetSegmentCuttable(logic.GetTrabecularBoneSegmentID(), True)
     assert logic.CutSphereSweep(cut, center, center, 2.0)
     assert logic.GetRemovedVolume(cut) > 30.0
+
+
+def test_a_corrupt_cut_file_is_refused_and_the_cut_kept(scene, tmp_path):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    logic.CutSphereSweep(cut, center, center, 2.0)
+    removed = logic.GetRemovedVolume(cut)
+
+    storage = cut.CreateDefaultStorageNode()
+    scene.AddNode(storage)
+    cut.SetAndObserveStorageNodeID(storage.GetID())
+    good = tmp_path / "cut.vcut"
+    storage.SetFileName(str(good))
+    assert storage.WriteData(cut)
+    assert cut.GetCutField().ComputeRemovedVolume() == pytest.approx(removed)
+
+    corrupt = tmp_path / "corrupt.vcut"
+    corrupt.write_bytes(good.read_bytes()[:100])
+    storage.SetFileName(str(corrupt))
+    assert not storage.ReadData(cut)
+    assert cut.GetCutField().ComputeRemovedVolume() == pytest.approx(removed)
+
+    storage.SetFileName(str(good))
+    assert storage.ReadData(cut)
+    assert cut.GetCutField().ComputeRemovedVolume() == pytest.approx(removed)
+
+
+def test_drilling_with_material_removal_through_the_logic(scene):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetCuttableSegmentIDs([logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()])
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    removed = []
+    logic.BeginStroke(cut)
+    for _ in range(4):
+        assert logic.DrillWithMaterialRemoval(cut, center, [0.0, 0.0, 1.0], 1.5, 0.1, slicer.vtkVolumeCutMaterialRemoval.CuttingBurr)
+        removed.append(logic.GetCutField(cut).ComputeRemovedVolume())
+    logic.EndStroke(cut)
+    # Trabecular bone (450 HU) gives way over time, not at once.
+    assert removed[0] < removed[-1]
+    assert all(a <= b for a, b in zip(removed, removed[1:]))
+    assert logic.UndoStroke(cut)
+    assert logic.GetRemovedVolume(cut) == 0.0
+    assert not logic.DrillWithMaterialRemoval(cut, center, [0.0, 0.0, 0.0], 1.5, 0.1, 0)
