@@ -4,6 +4,10 @@ Modules:
     phantom: procedural temporal-bone CT phantom with analytic geometry.
     headct: loader for the real head CT shipped by Debian (invesalius-examples).
     nodes: numpy <-> MRML volume helpers shared by the two.
+    application: a scene with Slicer's logics and an offscreen 3D view, without Qt.
+    drilling: scripted drilling paths (cortical mastoidectomy) replayed through the logic.
+    mainjob: the README's main job.
+    benchmarks: the benchmark harness (one JSON per area).
 
 Submodules are not imported here so that the numpy-only parts stay usable
 without VTK or Slicer.
