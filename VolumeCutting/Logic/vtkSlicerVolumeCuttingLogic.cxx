@@ -29,6 +29,8 @@
 // SegmentationCore includes
 #include <vtkBinaryLabelmapToClosedSurfaceConversionRule.h>
 #include <vtkClosedSurfaceToBinaryLabelmapConversionRule.h>
+#include <vtkClosedSurfaceToFractionalLabelmapConversionRule.h>
+#include <vtkFractionalLabelmapToClosedSurfaceConversionRule.h>
 #include <vtkOrientedImageData.h>
 #include <vtkOrientedImageDataResample.h>
 #include <vtkSegment.h>
@@ -49,6 +51,7 @@
 
 // STD includes
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 vtkStandardNewMacro(vtkSlicerVolumeCuttingLogic);
@@ -113,21 +116,20 @@ void vtkSlicerVolumeCuttingLogic::PrintSelf(ostream& os, vtkIndent indent)
 void vtkSlicerVolumeCuttingLogic::RegisterSegmentationConverterRules()
 {
   vtkSegmentationConverterFactory* factory = vtkSegmentationConverterFactory::GetInstance();
-  bool hasLabelmapToSurface = false;
-  bool hasSurfaceToLabelmap = false;
-  for (const auto& rule : factory->GetConverterRules())
-  {
-    hasLabelmapToSurface |= rule->IsA("vtkBinaryLabelmapToClosedSurfaceConversionRule") != 0;
-    hasSurfaceToLabelmap |= rule->IsA("vtkClosedSurfaceToBinaryLabelmapConversionRule") != 0;
-  }
-  if (!hasLabelmapToSurface)
-  {
-    factory->RegisterConverterRule(vtkSmartPointer<vtkBinaryLabelmapToClosedSurfaceConversionRule>::New());
-  }
-  if (!hasSurfaceToLabelmap)
-  {
-    factory->RegisterConverterRule(vtkSmartPointer<vtkClosedSurfaceToBinaryLabelmapConversionRule>::New());
-  }
+  auto registerOnce = [factory](vtkSegmentationConverterRule* newRule) {
+    for (const auto& rule : factory->GetConverterRules())
+    {
+      if (strcmp(rule->GetClassName(), newRule->GetClassName()) == 0)
+      {
+        return;
+      }
+    }
+    factory->RegisterConverterRule(newRule);
+  };
+  registerOnce(vtkSmartPointer<vtkBinaryLabelmapToClosedSurfaceConversionRule>::New());
+  registerOnce(vtkSmartPointer<vtkClosedSurfaceToBinaryLabelmapConversionRule>::New());
+  registerOnce(vtkSmartPointer<vtkFractionalLabelmapToClosedSurfaceConversionRule>::New());
+  registerOnce(vtkSmartPointer<vtkClosedSurfaceToFractionalLabelmapConversionRule>::New());
 }
 
 //----------------------------------------------------------------------------
@@ -771,4 +773,25 @@ void vtkSlicerVolumeCuttingLogic::ResetMaterialRemoval(vtkMRMLVolumeCutNode* cut
   {
     this->MaterialRemovals.erase(cutNode->GetID());
   }
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportRemovedFractionToVolume(vtkMRMLVolumeCutNode* cutNode, const char* name)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field || !this->GetMRMLScene())
+  {
+    return nullptr;
+  }
+  vtkNew<vtkImageData> fraction;
+  field->ExportRemovedFraction(fraction);
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed fraction";
+  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLScalarVolumeNode", nodeName));
+  volume->SetIJKToRASMatrix(ijkToRas);
+  volume->SetAndObserveImageData(fraction);
+  volume->CreateDefaultDisplayNodes();
+  return volume;
 }

@@ -121,6 +121,13 @@ public:
   /// nullptr and an error if the node has no cut field.
   vtkMRMLSegmentationNode* ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
 
+  /// The removed fraction (0..1) of each anatomy voxel as a float volume on
+  /// the anatomy's grid: the fractional labelmap of the removed region.
+  /// (Slicer-core's segmentation storage crashed reading back a segment whose
+  /// source representation is a fractional labelmap, so this is a volume,
+  /// which saves and reads like any other.)
+  vtkMRMLScalarVolumeNode* ExportRemovedFractionToVolume(vtkMRMLVolumeCutNode* cutNode, const char* name = nullptr);
+
   /// The segment kept out of cutting (protected, or without a role) that a tool
   /// touched most deeply since the last ResetContact of the node's field ("" if
   /// none); the field gives the depth (mm) and position.

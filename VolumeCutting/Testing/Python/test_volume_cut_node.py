@@ -292,3 +292,32 @@ def test_drilling_with_material_removal_through_the_logic(scene):
     assert logic.UndoStroke(cut)
     assert logic.GetRemovedVolume(cut) == 0.0
     assert not logic.DrillWithMaterialRemoval(cut, center, [0.0, 0.0, 0.0], 1.5, 0.1, 0)
+
+
+def test_fraction_export_keeps_partial_voxels_and_reloads(scene, tmp_path):
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
+    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    logic.CutSphereSweep(cut, center, center, 2.0)
+    removed = logic.GetRemovedVolume(cut)
+
+    exported = logic.ExportRemovedFractionToVolume(cut, None)
+    values = numpy_support.vtk_to_numpy(exported.GetImageData().GetPointData().GetScalars())
+    assert values.min() >= 0.0 and values.max() == pytest.approx(1.0)
+    assert ((values > 0.0) & (values < 1.0)).sum() > 10  # boundary voxels keep their fraction
+    assert values.sum() * 0.6 * 0.6 * 1.0 == pytest.approx(removed, rel=1e-3)
+    matrix, original = vtk.vtkMatrix4x4(), vtk.vtkMatrix4x4()
+    exported.GetIJKToRASMatrix(matrix)
+    volume.GetIJKToRASMatrix(original)
+    assert all(matrix.GetElement(r, c) == original.GetElement(r, c) for r in range(4) for c in range(4))
+
+    bundle = scene.application.save_bundle(tmp_path / "fraction.mrb")
+    reloaded = HeadlessSlicer()
+    reloaded.load_bundle(bundle)
+    read = reloaded.scene.GetFirstNodeByName(exported.GetName())
+    assert read is not None
+    read_values = numpy_support.vtk_to_numpy(read.GetImageData().GetPointData().GetScalars())
+    assert np.allclose(read_values, values)

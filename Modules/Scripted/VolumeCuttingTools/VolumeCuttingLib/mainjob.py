@@ -124,10 +124,12 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
         for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
     }
-    # Exports: the removed region as a segment (binary labelmap on the CT's
-    # grid), as a closed surface (STL), and the drilled CT.
+    # Exports: the removed region as a segment (binary labelmap) and as a
+    # fraction volume on the CT's grid, as a closed surface (STL), and the
+    # drilled CT.
     removed = logic.ExportRemovedRegionToSegmentation(cut_node, None)
     removed.GetDisplayNode().SetVisibility3D(False)
+    removed_fraction = logic.ExportRemovedFractionToVolume(cut_node, None)
     removed_model = logic.ExportRemovedSurfaceToModel(cut_node, None)
     storage = removed_model.CreateDefaultStorageNode()
     storage.SetFileName(str(out_dir / "removed.stl"))
@@ -185,6 +187,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         },
         "exports": {
             "removed_segmentation": removed.GetName(),
+            "removed_fraction_volume": removed_fraction.GetName(),
             "removed_surface_stl": str(out_dir / "removed.stl"),
             "removed_surface_triangles": removed_model.GetPolyData().GetNumberOfCells(),
             "drilled_ct": drilled_ct.GetName(),
