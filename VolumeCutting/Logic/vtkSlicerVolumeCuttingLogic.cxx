@@ -95,6 +95,17 @@ void AddLabelAsSegment(vtkSegmentation* segmentation, vtkImageData* labels, unsi
   segment->AddRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName(), mask);
   segmentation->AddSegment(segment, segmentId);
 }
+
+//----------------------------------------------------------------------------
+/// The user's name for an exported node, or the source's name and a suffix.
+std::string ExportName(const char* name, vtkMRMLNode* source, const char* suffix)
+{
+  if (name)
+  {
+    return name;
+  }
+  return std::string(source && source->GetName() ? source->GetName() : "Cut") + " " + suffix;
+}
 } // namespace
 
 //----------------------------------------------------------------------------
@@ -325,6 +336,7 @@ void vtkSlicerVolumeCuttingLogic::SetMRMLSceneInternal(vtkMRMLScene* newScene)
   this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
   this->ProtectionSources.clear();
   this->MaterialRemovals.clear();
+  this->RemovedFractions.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -334,6 +346,7 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
   {
     this->ProtectionSources.erase(node->GetID());
     this->MaterialRemovals.erase(node->GetID());
+    this->RemovedFractions.erase(node->GetID());
   }
 }
 
@@ -342,6 +355,7 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneEndClose()
 {
   this->ProtectionSources.clear();
   this->MaterialRemovals.clear();
+  this->RemovedFractions.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -605,14 +619,11 @@ double vtkSlicerVolumeCuttingLogic::GetRemovedVolumeInSegment(vtkMRMLVolumeCutNo
     vtkErrorMacro("GetRemovedVolumeInSegment: no segment '" << (segmentId ? segmentId : "") << "' in the cut node's segmentation");
     return -1.0;
   }
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
-  if (!field)
+  vtkImageData* fraction = this->GetRemovedFraction(cutNode);
+  if (!fraction)
   {
     return -1.0;
   }
-  vtkNew<vtkImageData> fraction;
-  field->ExportRemovedFraction(fraction);
-
   vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
   vtkNew<vtkOrientedImageData> anatomyGeometry;
   GetVolumeGeometry(anatomy, anatomyGeometry);
@@ -654,13 +665,11 @@ double vtkSlicerVolumeCuttingLogic::GetRemovedVolumeInSegment(vtkMRMLVolumeCutNo
 //----------------------------------------------------------------------------
 vtkMRMLSegmentationNode* vtkSlicerVolumeCuttingLogic::ExportRemovedRegionToSegmentation(vtkMRMLVolumeCutNode* cutNode, const char* name)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
-  if (!field || !this->GetMRMLScene())
+  vtkImageData* fraction = this->GetRemovedFraction(cutNode);
+  if (!fraction || !this->GetMRMLScene())
   {
     return nullptr;
   }
-  vtkNew<vtkImageData> fraction;
-  field->ExportRemovedFraction(fraction);
   vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
   vtkNew<vtkMatrix4x4> ijkToRas;
   anatomy->GetIJKToRASMatrix(ijkToRas);
@@ -674,7 +683,7 @@ vtkMRMLSegmentationNode* vtkSlicerVolumeCuttingLogic::ExportRemovedRegionToSegme
   {
     voxels[n] = fractions[n] >= 0.5f ? 1 : 0;
   }
-  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed";
+  const std::string nodeName = ExportName(name, cutNode, "removed");
   vtkMRMLSegmentationNode* segmentationNode = vtkMRMLSegmentationNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLSegmentationNode", nodeName));
   segmentationNode->CreateDefaultDisplayNodes();
   segmentationNode->SetReferenceImageGeometryParameterFromVolumeNode(anatomy);
@@ -696,7 +705,7 @@ vtkMRMLModelNode* vtkSlicerVolumeCuttingLogic::ExportRemovedSurfaceToModel(vtkMR
   }
   vtkNew<vtkPolyData> surface;
   field->ExtractRemovedSurface(surface);
-  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed surface";
+  const std::string nodeName = ExportName(name, cutNode, "removed surface");
   vtkMRMLModelNode* model = vtkMRMLModelNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLModelNode", nodeName));
   model->SetAndObservePolyData(surface);
   model->CreateDefaultDisplayNodes();
@@ -710,14 +719,12 @@ vtkMRMLModelNode* vtkSlicerVolumeCuttingLogic::ExportRemovedSurfaceToModel(vtkMR
 //----------------------------------------------------------------------------
 vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportDrilledVolume(vtkMRMLVolumeCutNode* cutNode, double fillValue, const char* name)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
-  if (!field || !this->GetMRMLScene())
+  vtkImageData* fraction = this->GetRemovedFraction(cutNode);
+  if (!fraction || !this->GetMRMLScene())
   {
     return nullptr;
   }
   vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
-  vtkNew<vtkImageData> fraction;
-  field->ExportRemovedFraction(fraction);
   vtkNew<vtkImageData> drilled;
   drilled->DeepCopy(anatomy->GetImageData());
   vtkDataArray* voxels = drilled->GetPointData()->GetScalars();
@@ -731,14 +738,7 @@ vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportDrilledVolume(vtkMRM
       voxels->SetComponent(n, 0, value + fractions[n] * (fillValue - value));
     }
   }
-  const std::string nodeName = name ? name : std::string(anatomy->GetName() ? anatomy->GetName() : "Volume") + " drilled";
-  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLScalarVolumeNode", nodeName));
-  vtkNew<vtkMatrix4x4> ijkToRas;
-  anatomy->GetIJKToRASMatrix(ijkToRas);
-  volume->SetIJKToRASMatrix(ijkToRas);
-  volume->SetAndObserveImageData(drilled);
-  volume->CreateDefaultDisplayNodes();
-  return volume;
+  return this->AddVolumeOnAnatomyGrid(anatomy, drilled, ExportName(name, anatomy, "drilled"));
 }
 
 //----------------------------------------------------------------------------
@@ -778,20 +778,43 @@ void vtkSlicerVolumeCuttingLogic::ResetMaterialRemoval(vtkMRMLVolumeCutNode* cut
 //----------------------------------------------------------------------------
 vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::ExportRemovedFractionToVolume(vtkMRMLVolumeCutNode* cutNode, const char* name)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
-  if (!field || !this->GetMRMLScene())
+  vtkImageData* fraction = this->GetRemovedFraction(cutNode);
+  if (!fraction || !this->GetMRMLScene())
   {
     return nullptr;
   }
-  vtkNew<vtkImageData> fraction;
-  field->ExportRemovedFraction(fraction);
-  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  // A copy: the node owns its voxels, the cached fraction stays the logic's.
+  vtkNew<vtkImageData> copy;
+  copy->DeepCopy(fraction);
+  return this->AddVolumeOnAnatomyGrid(cutNode->GetAnatomyVolumeNode(), copy, ExportName(name, cutNode, "removed fraction"));
+}
+
+//----------------------------------------------------------------------------
+vtkImageData* vtkSlicerVolumeCuttingLogic::GetRemovedFraction(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field)
+  {
+    return nullptr;
+  }
+  auto& cached = this->RemovedFractions[cutNode->GetID()];
+  if (!cached.second || cached.first != field->GetMTime())
+  {
+    cached.second = vtkSmartPointer<vtkImageData>::New();
+    field->ExportRemovedFraction(cached.second);
+    cached.first = field->GetMTime();
+  }
+  return cached.second;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLScalarVolumeNode* vtkSlicerVolumeCuttingLogic::AddVolumeOnAnatomyGrid(vtkMRMLScalarVolumeNode* anatomy, vtkImageData* image, const std::string& name)
+{
+  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLScalarVolumeNode", name));
   vtkNew<vtkMatrix4x4> ijkToRas;
   anatomy->GetIJKToRASMatrix(ijkToRas);
-  const std::string nodeName = name ? name : std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " removed fraction";
-  vtkMRMLScalarVolumeNode* volume = vtkMRMLScalarVolumeNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLScalarVolumeNode", nodeName));
   volume->SetIJKToRASMatrix(ijkToRas);
-  volume->SetAndObserveImageData(fraction);
+  volume->SetAndObserveImageData(image);
   volume->CreateDefaultDisplayNodes();
   return volume;
 }

@@ -30,6 +30,7 @@ class vtkMRMLModelNode;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
+class vtkImageData;
 class vtkMatrix4x4;
 class vtkVolumeCutField;
 class vtkVolumeCutMaterialRemoval;
@@ -162,6 +163,17 @@ protected:
   void OnMRMLSceneNodeRemoved(vtkMRMLNode* node) override;
   void OnMRMLSceneEndClose() override;
   void SetMRMLSceneInternal(vtkMRMLScene* newScene) override;
+
+  /// The removed fraction of each anatomy voxel (see
+  /// vtkVolumeCutField::ExportRemovedFraction), computed once per change of the
+  /// field and shared by the per-segment volumes and the exports.
+  vtkImageData* GetRemovedFraction(vtkMRMLVolumeCutNode* cutNode);
+
+  /// Add a scalar volume holding \a image on the anatomy's voxel grid.
+  vtkMRMLScalarVolumeNode* AddVolumeOnAnatomyGrid(vtkMRMLScalarVolumeNode* anatomy, vtkImageData* image, const std::string& name);
+
+  /// Removed fractions by cut-node ID, with the field modification time they match.
+  std::map<std::string, std::pair<vtkMTimeType, vtkSmartPointer<vtkImageData>>> RemovedFractions;
 
   /// The field for one pose: checked once per stroke, not per pose.
   vtkVolumeCutField* GetStrokeField(vtkMRMLVolumeCutNode* cutNode);

@@ -41,6 +41,20 @@ def add_ball_ct(scene, name="CT", spacing=(0.6, 0.6, 1.0)):
     return volume, int((r <= 5.0).sum()), int(((r > 5.0) & (r <= 7.0)).sum())
 
 
+# Centre of the ball of add_ball_ct (voxel 11, 11, 10) in RAS.
+BALL_CENTRE = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+
+
+def ball_session(scene, cuttable=("TrabecularBone",)):
+    """The ball CT, its bone segmentation and a cut node with these segments cuttable."""
+    volume, _, _ = add_ball_ct(scene)
+    logic = scene.volumeCuttingLogic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut = logic.AddVolumeCutNode(volume, bone)
+    cut.SetCuttableSegmentIDs(list(cuttable))
+    return volume, bone, cut, logic
+
+
 def test_classes_are_in_the_slicer_namespace():
     node = slicer.vtkMRMLVolumeCutNode()
     assert isinstance(node, slicer.vtkMRMLNode)
@@ -94,7 +108,7 @@ def test_save_scene_file_and_reload(scene, tmp_path):
     cut.SetSegmentCuttable(logic.GetTrabecularBoneSegmentID(), True)
     cut.SetSegmentProtected(logic.GetCorticalBoneSegmentID(), True)
     cut.SetSubVoxelFactor(4)
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    center = BALL_CENTRE
     assert logic.CutSphereSweep(cut, center, [center[0] + 2.0, center[1], center[2]], 1.5)
     removed = logic.GetRemovedVolume(cut)
     assert removed > 10.0
@@ -196,12 +210,8 @@ def test_bad_inputs_give_errors_not_crashes(scene):
 
 
 def test_exports_of_the_removed_region(scene, tmp_path):
-    volume, _, _ = add_ball_ct(scene)
-    logic = scene.volumeCuttingLogic
-    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
-    cut = logic.AddVolumeCutNode(volume, bone)
-    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    volume, bone, cut, logic = ball_session(scene)
+    center = BALL_CENTRE
     assert logic.CutSphereSweep(cut, center, center, 2.0)
     removed = logic.GetRemovedVolume(cut)
     assert abs(removed - 4.0 / 3.0 * np.pi * 8.0) / removed < 0.005
@@ -230,11 +240,8 @@ def test_exports_of_the_removed_region(scene, tmp_path):
 
 
 def test_tools_affect_only_cuttable_segments(scene):
-    volume, _, _ = add_ball_ct(scene)
-    logic = scene.volumeCuttingLogic
-    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
-    cut = logic.AddVolumeCutNode(volume, bone)
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    volume, bone, cut, logic = ball_session(scene, cuttable=())
+    center = BALL_CENTRE
     # No role yet: the trabecular ball is not the tool's to cut.
     assert logic.CutSphereSweep(cut, center, center, 2.0)
     assert logic.GetRemovedVolume(cut) < 0.01
@@ -245,12 +252,8 @@ def test_tools_affect_only_cuttable_segments(scene):
 
 
 def test_a_corrupt_cut_file_is_refused_and_the_cut_kept(scene, tmp_path):
-    volume, _, _ = add_ball_ct(scene)
-    logic = scene.volumeCuttingLogic
-    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
-    cut = logic.AddVolumeCutNode(volume, bone)
-    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    volume, bone, cut, logic = ball_session(scene)
+    center = BALL_CENTRE
     logic.CutSphereSweep(cut, center, center, 2.0)
     removed = logic.GetRemovedVolume(cut)
 
@@ -274,12 +277,8 @@ def test_a_corrupt_cut_file_is_refused_and_the_cut_kept(scene, tmp_path):
 
 
 def test_drilling_with_material_removal_through_the_logic(scene):
-    volume, _, _ = add_ball_ct(scene)
-    logic = scene.volumeCuttingLogic
-    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
-    cut = logic.AddVolumeCutNode(volume, bone)
-    cut.SetCuttableSegmentIDs([logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()])
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    volume, bone, cut, logic = ball_session(scene, cuttable=("CorticalBone", "TrabecularBone"))
+    center = BALL_CENTRE
     removed = []
     logic.BeginStroke(cut)
     for _ in range(4):
@@ -295,12 +294,8 @@ def test_drilling_with_material_removal_through_the_logic(scene):
 
 
 def test_fraction_export_keeps_partial_voxels_and_reloads(scene, tmp_path):
-    volume, _, _ = add_ball_ct(scene)
-    logic = scene.volumeCuttingLogic
-    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
-    cut = logic.AddVolumeCutNode(volume, bone)
-    cut.SetCuttableSegmentIDs([logic.GetTrabecularBoneSegmentID()])
-    center = [-5.0 + 11 * 0.6, 3.0 + 11 * 0.6, 20.0 + 10 * 1.0]
+    volume, bone, cut, logic = ball_session(scene)
+    center = BALL_CENTRE
     logic.CutSphereSweep(cut, center, center, 2.0)
     removed = logic.GetRemovedVolume(cut)
 
