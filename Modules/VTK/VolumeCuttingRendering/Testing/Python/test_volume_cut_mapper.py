@@ -1,0 +1,425 @@
+"""Adaptive multivolume ray casting: CPU reference and OpenGL path against exact geometry.
+
+Every image is compared with a ray tracing of the true scene (VolumeCuttingLib
+.analyticscene) or with the other implementation, never with a stored image.
+The OpenGL path runs on whatever context VTK gives offscreen (Mesa llvmpipe
+through EGL on CI), so images are kept small.
+"""
+
+import math
+
+import numpy as np
+import pytest
+import slicer_volumecutting as vc
+import vtk
+from vtkmodules.util import numpy_support
+
+from VolumeCuttingLib import analyticscene as A
+
+
+class ErrorLog:
+    """Collects the errors (and warnings) an object reports instead of printing them."""
+
+    def __init__(self, obj, warnings=False):
+        self.messages = []
+        obj.AddObserver(vtk.vtkCommand.ErrorEvent, self._collect)
+        if warnings:
+            obj.AddObserver(vtk.vtkCommand.WarningEvent, self._collect)
+
+    def _collect(self, caller, event, calldata=None):
+        self.messages.append(str(calldata))
+
+    _collect.CallDataType = vtk.VTK_STRING
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return A.default_scene()
+
+
+@pytest.fixture(scope="module")
+def intensities(scene):
+    return scene.intensities()
+
+
+def image_array(getter, height, width, components):
+    image = vtk.vtkImageData()
+    getter(image)
+    values = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars())
+    return values.reshape(height, width, components) if components > 1 else values.reshape(height, width)
+
+
+def cast(scene, intensities, cut, width, pixels_per_voxel=8.0, camera=None, configure=None):
+    caster = vc.vtkVolumeCutRayCaster()
+    caster.SetAnatomy(intensities, scene.ijk_to_ras())
+    caster.SetIsoValue(scene.iso_value())
+    if cut is not None:
+        caster.AddCutField(cut)
+    if configure:
+        configure(caster)
+    camera = camera or A.make_camera(scene, pixels_per_voxel, width, width)
+    matrix = A.world_to_ndc(camera, width, width)
+    assert caster.Render(matrix, width, width)
+    return caster, matrix
+
+
+def classes_from_depth(scene, matrix, depth):
+    points = A.depth_to_points(matrix, depth.astype(float))
+    valid = depth < 1.0
+    classes = scene.classify_points(np.nan_to_num(points.reshape(-1, 3)), valid.ravel()).reshape(depth.shape)
+    return points, classes
+
+
+def test_cpu_reference_places_cut_edges_and_silhouettes_exactly(scene, intensities):
+    width = 160
+    cut = scene.cut_field(2)
+    caster, matrix = cast(scene, intensities, cut, width)
+    depth = image_array(caster.GetDepthImage, width, width, 1)
+    normals = image_array(caster.GetNormalImage, width, width, 3).astype(float)
+    reference = A.exact_reference(scene, matrix, width, width, supersampling=4)
+    # The view must hold what is measured: background, cube faces and cuts.
+    assert set(np.unique(reference.classes)) == {A.BACKGROUND, A.CUBE, A.CUT}
+    _, classes = classes_from_depth(scene, matrix, depth)
+    edges = A.edge_errors(reference, classes)
+    assert edges.size < 0.01 * width * width
+    assert edges.max(initial=0.0) <= 0.5  # pixels, at 8 pixels per voxel
+    angles = A.normal_errors(reference, normals, classes)
+    assert np.median(angles) <= 2.0
+    assert np.percentile(angles, 95) <= 5.0
+    # The border kinds are reported: cut surfaces by their field, faces as objects.
+    sources = image_array(caster.GetSourceImage, width, width, 1)
+    assert np.any(sources == vc.vtkVolumeCutRayCaster.SourceCutField)
+    assert np.any(sources == vc.vtkVolumeCutRayCaster.SourceObject)
+
+
+def test_whole_voxel_masking_misses_the_edges_the_field_places(scene, intensities):
+    """The same metric detects the staircase of masking by whole voxels (the baseline)."""
+    width = 160
+    cut = scene.cut_field(2)
+    fraction = vtk.vtkImageData()
+    cut.ExportRemovedFraction(fraction)
+    values = numpy_support.vtk_to_numpy(intensities.GetPointData().GetScalars()).copy()
+    values[numpy_support.vtk_to_numpy(fraction.GetPointData().GetScalars()) >= 0.5] = 0.0
+    masked = vtk.vtkImageData()
+    masked.SetDimensions(intensities.GetDimensions())
+    masked.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values, deep=True))
+    caster, matrix = cast(scene, masked, None, width)
+    depth = image_array(caster.GetDepthImage, width, width, 1)
+    reference = A.exact_reference(scene, matrix, width, width, supersampling=4)
+    _, classes = classes_from_depth(scene, matrix, depth)
+    assert A.edge_errors(reference, classes).max(initial=0.0) > 1.0
+
+
+def render_window(width):
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(width, width)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    return window, renderer
+
+
+def add_cut_volume(scene, intensities, cut, renderer):
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(intensities)
+    mapper.GetRayCaster().SetIsoValue(scene.iso_value())
+    if cut is not None:
+        mapper.GetRayCaster().AddCutField(cut)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetUserMatrix(scene.ijk_to_ras())
+    renderer.AddVolume(volume)
+    return mapper, volume
+
+
+def read_window(window, width):
+    depth = vtk.vtkFloatArray()
+    window.GetZbufferData(0, 0, width - 1, width - 1, depth)
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
+    return (
+        numpy_support.vtk_to_numpy(depth).reshape(width, width),
+        numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4).astype(int),
+    )
+
+
+def test_gpu_and_cpu_paths_draw_the_same_image(scene, intensities):
+    width = 96
+    cut = scene.cut_field(2)
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 8.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    # Stated tolerance: depth within 1e-4 of the window range, colour within
+    # 2/255 on 99.5 % of pixels (float vs double arithmetic).
+    assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+    # And the OpenGL path is exact on its own.
+    matrix = A.world_to_ndc(renderer.GetActiveCamera(), width, width)
+    reference = A.exact_reference(scene, matrix, width, width, supersampling=4)
+    _, classes = classes_from_depth(scene, matrix, gpu_depth)
+    assert A.edge_errors(reference, classes).max(initial=0.0) <= 0.5
+
+
+@pytest.mark.parametrize("path", ["CPUPath", "GPUPath"])
+def test_depth_composites_with_other_actors(scene, intensities, path):
+    width = 64
+    window, renderer = render_window(width)
+    camera = A.make_camera(scene, 2.0, width, width)
+    renderer.SetActiveCamera(camera)
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    mapper.SetRequestedRenderPath(getattr(vc.vtkVolumeCutVolumeMapper, path))
+    window.Render()
+    alone, _ = read_window(window, width)
+    # A red ball between the camera and the cube, covering part of it.
+    source = vtk.vtkSphereSource()
+    focal = np.array(camera.GetFocalPoint())
+    toward = np.array(camera.GetPosition()) - focal
+    source.SetCenter(*(focal + 0.3 * toward))
+    source.SetRadius(0.02 * np.linalg.norm(toward))
+    source.SetThetaResolution(32)
+    source.SetPhiResolution(32)
+    ball = vtk.vtkActor()
+    ball.SetMapper(vtk.vtkPolyDataMapper())
+    ball.GetMapper().SetInputConnection(source.GetOutputPort())
+    ball.GetProperty().SetColor(1.0, 0.0, 0.0)
+    ball.GetProperty().SetAmbient(1.0)
+    ball.GetProperty().SetDiffuse(0.0)
+    renderer.AddActor(ball)
+    window.Render()
+    depth, color = read_window(window, width)
+    covered = depth < alone - 1e-3
+    assert covered.sum() > 20
+    # The ball's colour, never the bone's (the volume is not drawn over it).
+    assert np.all(color[covered][:, 1] < 60) and np.all(color[covered][:, 0] > color[covered][:, 1] + 60)
+    # Where the ball is not, the cube's surface depth is kept.
+    assert np.allclose(depth[~covered], alone[~covered], atol=1e-5)
+
+
+def test_localized_update_recasts_only_the_stroke(scene, intensities):
+    width = 128
+    cut = scene.cut_field(2)
+    caster, matrix = cast(scene, intensities, cut, width, pixels_per_voxel=4.0)
+    assert not caster.GetLastRenderWasLocalized()
+    # One burr stroke on the visible top face.
+    top = scene.center + np.array([0.2, -0.2, 1.0]) * scene.half_size
+    cut.CutCapsule(list(top), list(top + [0.4, 0.0, 0.0]), 1.0)
+    assert caster.Render(matrix, width, width)
+    assert caster.GetLastRenderWasLocalized()
+    # Whole bricks (2 mm here, with the interpolation's reach) are recast.
+    assert 0 < caster.GetNumberOfRaysCast() < 0.3 * width * width
+    localized = image_array(caster.GetColorImage, width, width, 4)
+    fresh, _ = cast(scene, intensities, cut, width, pixels_per_voxel=4.0)
+    assert np.array_equal(localized, image_array(fresh.GetColorImage, width, width, 4))
+    # Nothing changed: nothing is cast.
+    assert caster.Render(matrix, width, width)
+    assert caster.GetNumberOfRaysCast() == 0
+
+
+def test_clip_plane_opens_the_cube(scene, intensities):
+    width = 64
+    camera = vtk.vtkCamera()
+    center = scene.center
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(*(center + [0.0, 0.0, 100.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(50.0, 200.0)
+    planes = vtk.vtkPlaneCollection()
+    plane = vtk.vtkPlane()
+    plane.SetOrigin(*(center + [0.0, 0.0, 0.1]))
+    plane.SetNormal(0.0, 0.0, -1.0)  # keep below the plane: the top half is clipped away
+    planes.AddItem(plane)
+    caster, matrix = cast(scene, intensities, None, width, camera=camera, configure=lambda c: c.SetClippingPlanes(planes))
+    depth = image_array(caster.GetDepthImage, width, width, 1)
+    sources = image_array(caster.GetSourceImage, width, width, 1)
+    middle = width // 2
+    assert sources[middle, middle] == vc.vtkVolumeCutRayCaster.SourceClipPlane
+    point = A.depth_to_points(matrix, depth.astype(float))[middle, middle]
+    assert point[2] == pytest.approx(center[2] + 0.1, abs=1e-3)
+
+
+def test_composite_mode_sees_through_the_removed_region(scene, intensities):
+    width = 48
+    cut = vc.vtkVolumeCutField()
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    center = scene.center
+    top = center + [0.0, 0.0, scene.half_size]
+    cut.CutCapsule(list(top), list(top), 3.0)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(*(center + [0.0, 0.0, 100.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(50.0, 200.0)
+    color = vtk.vtkColorTransferFunction()
+    color.AddRGBPoint(0.0, 1.0, 1.0, 1.0)
+    color.AddRGBPoint(1000.0, 1.0, 0.9, 0.8)
+    opacity = vtk.vtkPiecewiseFunction()
+    opacity.AddPoint(0.0, 0.0)
+    opacity.AddPoint(400.0, 0.0)
+    opacity.AddPoint(1000.0, 0.5)
+
+    def composite(caster):
+        caster.SetBlendMode(vc.vtkVolumeCutRayCaster.CompositeBlend)
+        caster.SetTransferFunctions(color, opacity)
+
+    caster, matrix = cast(scene, intensities, cut, width, camera=camera, configure=composite)
+    depth = image_array(caster.GetDepthImage, width, width, 1)
+    middle = width // 2
+    point = A.depth_to_points(matrix, depth.astype(float))[middle, middle]
+    # The first material along the central ray is the bottom of the spherical pit.
+    off_axis = math.hypot(point[0] - top[0], point[1] - top[1])
+    assert point[2] == pytest.approx(top[2] - math.sqrt(9.0 - off_axis**2), abs=0.01)
+    sources = image_array(caster.GetSourceImage, width, width, 1)
+    assert sources[middle, middle] == vc.vtkVolumeCutRayCaster.SourceCutField
+
+
+def test_thin_bone_shows_red_and_translucent(scene, intensities):
+    width = 48
+    cut = vc.vtkVolumeCutField()
+    cut.SetMaximumStrokeLength(1000.0)
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    center = scene.center
+    h = scene.half_size
+    # Hollow the cube from below, leaving a 0.4 mm roof under the top face.
+    cut.CutCapsule(list(center + [0.0, 0.0, h - 0.4 - 4.0]), list(center + [0.0, 0.0, -2.0 * h]), 4.0)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(*(center + [0.0, 0.0, 100.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(50.0, 200.0)
+
+    def thin(caster):
+        caster.ThinBoneShadingOn()
+        caster.SetThinBoneThickness(1.5)
+
+    caster, _ = cast(scene, intensities, cut, width, camera=camera, configure=thin)
+    rgba = image_array(caster.GetColorImage, width, width, 4)
+    middle = width // 2
+    roof = rgba[middle, middle]
+    assert roof[0] > 1.5 * roof[1]  # red
+    corner_of_face = rgba[middle + 5, middle + 5]  # thick bone away from the hollow
+    assert corner_of_face[0] < 1.2 * corner_of_face[1]
+    assert roof[3] < 0.999  # what lies behind shows through
+    plain, _ = cast(scene, intensities, cut, width, camera=camera)
+    unshaded = image_array(plain.GetColorImage, width, width, 4)[middle, middle]
+    assert unshaded[0] < 1.2 * unshaded[1]
+
+
+def test_bad_input_gives_clear_errors_and_keeps_rendering(scene, intensities):
+    width = 32
+    caster = vc.vtkVolumeCutRayCaster()
+    log = ErrorLog(caster)
+    matrix = A.world_to_ndc(A.make_camera(scene, 1.0, width, width), width, width)
+    assert not caster.Render(matrix, width, width)
+    assert "no anatomy" in log.messages[-1]
+
+    flat = vtk.vtkImageData()
+    flat.SetDimensions(10, 10, 1)
+    flat.AllocateScalars(vtk.VTK_FLOAT, 1)
+    caster.SetAnatomy(flat, None)
+    assert not caster.Render(matrix, width, width)
+    assert "at least 2 voxels" in log.messages[-1]
+
+    # A cut field on another grid is refused with a message; the anatomy still renders.
+    caster.SetAnatomy(intensities, scene.ijk_to_ras())
+    caster.SetIsoValue(scene.iso_value())
+    other = vc.vtkVolumeCutField()
+    other.Initialize([scene.dimensions + 1] * 3, scene.ijk_to_ras(), 2)
+    other.CutCapsule(list(scene.center), list(scene.center), 5.0)
+    caster.AddCutField(other)
+    assert caster.Render(matrix, width, width)
+    assert any("not made on the anatomy's voxel grid" in m for m in log.messages)
+    depth = image_array(caster.GetDepthImage, width, width, 1)
+    assert np.any(depth < 1.0)
+
+    # An empty cut field changes nothing.
+    caster.RemoveAllCutFields()
+    empty = vc.vtkVolumeCutField()
+    empty.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    caster.AddCutField(empty)
+    assert caster.Render(matrix, width, width)
+    assert np.array_equal(image_array(caster.GetDepthImage, width, width, 1), depth)
+
+    # A label map of the wrong size is refused; rendering goes on without labels.
+    labels = vtk.vtkImageData()
+    labels.SetDimensions(5, 5, 5)
+    labels.AllocateScalars(vtk.VTK_UNSIGNED_SHORT, 1)
+    caster.SetLabelMap(labels)
+    assert caster.Render(matrix, width, width)
+    assert "label map must have the anatomy's dimensions" in log.messages[-1]
+
+    # NaN intensities neither crash nor show.
+    values = numpy_support.vtk_to_numpy(intensities.GetPointData().GetScalars()).copy()
+    values[: values.size // 2] = np.nan
+    nan_image = vtk.vtkImageData()
+    nan_image.SetDimensions(intensities.GetDimensions())
+    nan_image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values, deep=True))
+    caster.SetLabelMap(None)
+    caster.SetAnatomy(nan_image, scene.ijk_to_ras())
+    assert caster.Render(matrix, width, width)
+
+
+def test_hundreds_of_segments_render_with_their_colours(scene, intensities):
+    width = 48
+    n = scene.dimensions
+    labels = np.zeros((n, n, n), np.uint16)
+    # 300 slabs along x, each its own segment.
+    labels[:, :, :] = (np.arange(n) % 300 + 1)[None, None, :]
+    labels[:, :, : n // 2] = 7
+    label_image = vtk.vtkImageData()
+    label_image.SetDimensions(n, n, n)
+    label_image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(labels.ravel(), deep=True))
+
+    def segments(caster):
+        caster.SetLabelMap(label_image)
+        for label in range(1, 301):
+            color = (1.0, 0.0, 0.0) if label == 7 else (0.0, 0.0, 1.0)
+            caster.SetSegmentAppearance(label, color, 1.0, scene.iso_value())
+
+    caster, _ = cast(scene, intensities, None, width, pixels_per_voxel=1.0, configure=segments)
+    assert caster.GetNumberOfSegmentAppearances() == 300
+    rgba = image_array(caster.GetColorImage, width, width, 4)
+    hit = rgba[..., 3] > 0.5
+    red = hit & (rgba[..., 0] > rgba[..., 2])
+    blue = hit & (rgba[..., 2] > rgba[..., 0])
+    assert red.sum() > 20 and blue.sum() > 20
+
+
+def test_gpu_path_falls_back_to_the_cpu_with_a_reason():
+    width = 32
+    window, renderer = render_window(width)
+    big = vtk.vtkImageData()
+    big.SetDimensions(20000, 8, 8)  # longer than any GPU's 3D texture side
+    big.SetSpacing(0.002, 2.5, 2.5)
+    big.AllocateScalars(vtk.VTK_FLOAT, 1)
+    big.GetPointData().GetScalars().Fill(1000.0)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(big)
+    mapper.GetRayCaster().SetIsoValue(500.0)
+    log = ErrorLog(mapper, warnings=True)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    renderer.AddVolume(volume)
+    renderer.ResetCamera()
+    window.Render()
+    assert mapper.GetLastRenderPath() == vc.vtkVolumeCutVolumeMapper.CPUPath
+    assert "3D texture limit" in mapper.GetGPUFallbackReason()
+    assert any("Rendering cuts on the CPU" in m for m in log.messages)
+    depth, _ = read_window(window, width)
+    assert np.any(depth < 1.0)
+    # Without input: nothing drawn, no crash (the renderer may not even call it).
+    empty_mapper = vc.vtkVolumeCutVolumeMapper()
+    empty_volume = vtk.vtkVolume()
+    empty_volume.SetMapper(empty_mapper)
+    renderer.AddVolume(empty_volume)
+    window.Render()
+    assert empty_mapper.GetLastRenderPath() == 0
+    assert math.isfinite(mapper.GetLastFrameTime())

@@ -1,0 +1,635 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutOpenGLRayCaster.h"
+
+#include "vtkVolumeCutField.h"
+#include "vtkVolumeCutRayCastFS.h"
+#include "vtkVolumeCutRayCaster.h"
+
+#include <vtkIdList.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOpenGLQuadHelper.h>
+#include <vtkOpenGLRenderUtilities.h>
+#include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLShaderCache.h>
+#include <vtkOpenGLState.h>
+#include <vtkShaderProgram.h>
+#include <vtkSmartPointer.h>
+#include <vtkTextureObject.h>
+#include <vtk_glad.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+vtkStandardNewMacro(vtkVolumeCutOpenGLRayCaster);
+
+namespace
+{
+// The per-cut-field part of the shader; @N@ is the field's index.
+const char* const CutDeclarationTemplate = R"GLSL(
+uniform sampler3D cutPage@N@;
+uniform sampler3D cutAtlas@N@;
+uniform vec3 cutDimensionsF@N@;
+uniform int cutSlots@N@;
+uniform mat4 worldToSub@N@;
+uniform float cutQuantum@N@;
+uniform float cutStep@N@;
+ivec3 cutDimensions@N@;
+float cutSample@N@(ivec3 c)
+{
+  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, cutDimensions@N@)))
+  {
+    return 32767.0;
+  }
+  ivec3 b = c / 8;
+  float slot = texelFetch(cutPage@N@, b, 0).r;
+  if (slot < 0.0)
+  {
+    return 32767.0;
+  }
+  int s = int(slot + 0.5);
+  ivec3 origin = 8 * ivec3(s % cutSlots@N@, (s / cutSlots@N@) % cutSlots@N@, s / (cutSlots@N@ * cutSlots@N@));
+  return texelFetch(cutAtlas@N@, origin + (c - 8 * b), 0).r;
+}
+float cutDistance@N@(vec3 world)
+{
+  vec3 index = (worldToSub@N@ * vec4(world, 1.0)).xyz;
+  ivec3 i0 = ivec3(floor(index));
+  vec3 f = index - vec3(i0);
+  float value = 0.0;
+  vec3 second = vec3(0.0);
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    ivec3 c = i0 + ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    float w = ((corner & 1) != 0 ? f.x : 1.0 - f.x) * ((corner & 2) != 0 ? f.y : 1.0 - f.y) * ((corner & 4) != 0 ? f.z : 1.0 - f.z);
+    if (w == 0.0)
+    {
+      continue;
+    }
+    float center = cutSample@N@(c);
+    value += w * center;
+    if (abs(center) == 32767.0)
+    {
+      continue;
+    }
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      ivec3 e = ivec3(0);
+      e[axis] = 1;
+      float n0 = cutSample@N@(c - e);
+      float n1 = cutSample@N@(c + e);
+      if (abs(n0) != 32767.0 && abs(n1) != 32767.0)
+      {
+        second[axis] += w * (n0 - 2.0 * center + n1);
+      }
+    }
+  }
+  value -= 0.5 * dot(f * (1.0 - f), second);
+  return value * cutQuantum@N@;
+}
+)GLSL";
+
+std::string Replace(std::string text, const std::string& what, const std::string& with)
+{
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size()))
+  {
+    text.replace(at, what.size(), with);
+  }
+  return text;
+}
+
+std::string FragmentShader(int cuts)
+{
+  std::string declarations;
+  std::string calls;
+  std::string init;
+  std::ostringstream steps;
+  steps << "float cutStepOf(int n)\n{\n";
+  for (int n = 0; n < cuts; ++n)
+  {
+    const std::string index = std::to_string(n);
+    declarations += Replace(CutDeclarationTemplate, "@N@", index);
+    calls += "  if (n == " + index + ")\n  {\n    return cutDistance" + index + "(world);\n  }\n";
+    init += "  cutDimensions" + index + " = ivec3(cutDimensionsF" + index + " + 0.5);\n";
+    steps << "  if (n == " << n << ")\n  {\n    return cutStep" << n << ";\n  }\n";
+  }
+  steps << "  return 1.0;\n}\n";
+  std::string source = vtkVolumeCutRayCastFS;
+  const std::string defines =
+    "#define NUMBER_OF_CUTS " + std::to_string(cuts) + "\n#define CUT_SLOTS " + std::to_string(std::max(cuts, 1)) + "\n";
+  source = Replace(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
+  source = Replace(source, "//VolumeCut::CutDecl", declarations + steps.str());
+  source = Replace(source, "//VolumeCut::CutCalls", calls);
+  source = Replace(source, "//VolumeCut::CutInit", init);
+  return source;
+}
+
+void ColumnMajor(const double rowMajor[16], float out[16])
+{
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      out[column * 4 + row] = static_cast<float>(rowMajor[row * 4 + column]);
+    }
+  }
+}
+
+struct CutTextures
+{
+  vtkVolumeCutField* Field = nullptr;
+  vtkSmartPointer<vtkTextureObject> Page;
+  vtkSmartPointer<vtkTextureObject> Atlas;
+  int SlotsPerAxis = 0;
+  int UsedSlots = 0;
+  std::vector<int> SlotOfBrick;
+  vtkTypeUInt64 Stamp = 0;
+  int Dimensions[3] = { 0, 0, 0 };
+};
+}
+
+//------------------------------------------------------------------------------
+struct vtkVolumeCutOpenGLRayCaster::Internals
+{
+  vtkOpenGLRenderWindow* Context = nullptr;
+  vtkSmartPointer<vtkTextureObject> Anatomy;
+  vtkSmartPointer<vtkTextureObject> Labels;
+  vtkSmartPointer<vtkTextureObject> Styles;
+  vtkSmartPointer<vtkTextureObject> Blocks;
+  vtkSmartPointer<vtkTextureObject> Transfer;
+  vtkSmartPointer<vtkTextureObject> OpaqueDepth;
+  CutTextures Cuts[MaximumNumberOfCutFields];
+  vtkMTimeType AnatomyVersion = 0;
+  vtkMTimeType SceneVersion = 0;
+  int ShaderCuts = -1;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+
+  void Release(vtkWindow* window)
+  {
+    for (vtkTextureObject* texture : { this->Anatomy.GetPointer(), this->Labels.GetPointer(), this->Styles.GetPointer(),
+           this->Blocks.GetPointer(), this->Transfer.GetPointer(), this->OpaqueDepth.GetPointer() })
+    {
+      if (texture)
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
+    }
+    this->Anatomy = this->Labels = this->Styles = this->Blocks = this->Transfer = this->OpaqueDepth = nullptr;
+    for (CutTextures& cut : this->Cuts)
+    {
+      if (cut.Page)
+      {
+        cut.Page->ReleaseGraphicsResources(window);
+        cut.Atlas->ReleaseGraphicsResources(window);
+      }
+      cut = CutTextures();
+    }
+    if (this->Quad)
+    {
+      this->Quad->ReleaseGraphicsResources(window);
+      this->Quad.reset();
+    }
+    this->AnatomyVersion = 0;
+    this->SceneVersion = 0;
+    this->ShaderCuts = -1;
+    this->Context = nullptr;
+  }
+
+  static vtkSmartPointer<vtkTextureObject> Texture3D(
+    vtkOpenGLRenderWindow* window, int x, int y, int z, int components, const float* data)
+  {
+    auto texture = vtkSmartPointer<vtkTextureObject>::New();
+    texture->SetContext(window);
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetWrapR(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    if (!texture->Create3DFromRaw(x, y, z, components, VTK_FLOAT, const_cast<float*>(data)))
+    {
+      return nullptr;
+    }
+    return texture;
+  }
+
+  static vtkSmartPointer<vtkTextureObject> Texture2D(vtkOpenGLRenderWindow* window, int x, int y, int components, const float* data)
+  {
+    auto texture = vtkSmartPointer<vtkTextureObject>::New();
+    texture->SetContext(window);
+    texture->SetWrapS(vtkTextureObject::ClampToEdge);
+    texture->SetWrapT(vtkTextureObject::ClampToEdge);
+    texture->SetMinificationFilter(vtkTextureObject::Nearest);
+    texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    if (!texture->Create2DFromRaw(x, y, components, VTK_FLOAT, const_cast<float*>(data)))
+    {
+      return nullptr;
+    }
+    return texture;
+  }
+
+  // Bring one cut field's page table and atlas up to date; returns the
+  // number of bricks uploaded, or -1 when a texture cannot be made.
+  vtkIdType UpdateCut(vtkOpenGLRenderWindow* window, CutTextures& cut, vtkVolumeCutField* field)
+  {
+    const int* brickDims = field->GetBrickDimensions();
+    const vtkIdType brickCount = static_cast<vtkIdType>(brickDims[0]) * brickDims[1] * brickDims[2];
+    const int* dims = field->GetDimensions();
+    const bool sameField = cut.Field == field && cut.Page && cut.Dimensions[0] == dims[0] && cut.Dimensions[1] == dims[1] &&
+      cut.Dimensions[2] == dims[2];
+    vtkNew<vtkIdList> modified;
+    field->GetBricksModifiedSince(sameField ? cut.Stamp : 0, modified);
+    const vtkTypeUInt64 stamp = field->GetCurrentStamp();
+    if (sameField && modified->GetNumberOfIds() == 0)
+    {
+      cut.Stamp = stamp;
+      return 0;
+    }
+    // Slots needed: those in use plus the new bricks.
+    int newBricks = 0;
+    if (sameField)
+    {
+      for (vtkIdType n = 0; n < modified->GetNumberOfIds(); ++n)
+      {
+        newBricks += cut.SlotOfBrick[modified->GetId(n)] < 0 ? 1 : 0;
+      }
+    }
+    const bool rebuild = !sameField || cut.UsedSlots + newBricks > cut.SlotsPerAxis * cut.SlotsPerAxis * cut.SlotsPerAxis;
+    if (rebuild)
+    {
+      if (sameField)
+      {
+        // The atlas is full: start again with room to grow, uploading every brick.
+        field->GetBricksModifiedSince(0, modified);
+      }
+      const vtkIdType needed = std::max<vtkIdType>(8, field->GetNumberOfAllocatedBricks() + modified->GetNumberOfIds());
+      int slots = static_cast<int>(std::ceil(std::cbrt(1.5 * static_cast<double>(needed))));
+      GLint maximum3D = 0;
+      glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &maximum3D);
+      if (8 * slots > maximum3D || brickDims[0] > maximum3D || brickDims[1] > maximum3D || brickDims[2] > maximum3D)
+      {
+        return -1;
+      }
+      std::vector<float> page(brickCount, -1.f);
+      cut = CutTextures();
+      cut.Page = Texture3D(window, brickDims[0], brickDims[1], brickDims[2], 1, page.data());
+      std::vector<float> empty(static_cast<size_t>(8 * slots) * 8 * slots * 8 * slots, 32767.f);
+      cut.Atlas = Texture3D(window, 8 * slots, 8 * slots, 8 * slots, 1, empty.data());
+      if (!cut.Page || !cut.Atlas)
+      {
+        cut = CutTextures();
+        return -1;
+      }
+      cut.Field = field;
+      cut.SlotsPerAxis = slots;
+      cut.SlotOfBrick.assign(brickCount, -1);
+      std::copy(dims, dims + 3, cut.Dimensions);
+    }
+    std::vector<short> values(vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize);
+    std::vector<float> floats(values.size());
+    vtkIdType uploaded = 0;
+    for (vtkIdType n = 0; n < modified->GetNumberOfIds(); ++n)
+    {
+      const vtkIdType id = modified->GetId(n);
+      field->CopyBrick(id, values.data());
+      std::copy(values.begin(), values.end(), floats.begin());
+      int& slot = cut.SlotOfBrick[id];
+      if (slot < 0)
+      {
+        slot = cut.UsedSlots++;
+        const float slotValue = static_cast<float>(slot);
+        const int b[3] = { static_cast<int>(id % brickDims[0]), static_cast<int>((id / brickDims[0]) % brickDims[1]),
+          static_cast<int>(id / (static_cast<vtkIdType>(brickDims[0]) * brickDims[1])) };
+        cut.Page->Bind();
+        glTexSubImage3D(GL_TEXTURE_3D, 0, b[0], b[1], b[2], 1, 1, 1, GL_RED, GL_FLOAT, &slotValue);
+      }
+      const int s = cut.SlotsPerAxis;
+      cut.Atlas->Bind();
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      glTexSubImage3D(GL_TEXTURE_3D, 0, 8 * (slot % s), 8 * ((slot / s) % s), 8 * (slot / (s * s)), 8, 8, 8, GL_RED, GL_FLOAT,
+        floats.data());
+      ++uploaded;
+    }
+    cut.Stamp = stamp;
+    return uploaded;
+  }
+};
+
+//------------------------------------------------------------------------------
+vtkVolumeCutOpenGLRayCaster::vtkVolumeCutOpenGLRayCaster()
+  : Impl(new Internals)
+{
+}
+
+//------------------------------------------------------------------------------
+vtkVolumeCutOpenGLRayCaster::~vtkVolumeCutOpenGLRayCaster()
+{
+  if (this->Impl->Context)
+  {
+    this->Impl->Release(this->Impl->Context);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::ReleaseGraphicsResources(vtkWindow* window)
+{
+  this->Impl->Release(window);
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutOpenGLRayCaster::GetTextureMemorySize() const
+{
+  size_t bytes = 0;
+  auto add = [&bytes](vtkTextureObject* texture) {
+    if (texture)
+    {
+      bytes += static_cast<size_t>(texture->GetWidth()) * texture->GetHeight() * std::max(1u, texture->GetDepth()) *
+        texture->GetComponents() * sizeof(float);
+    }
+  };
+  add(this->Impl->Anatomy);
+  add(this->Impl->Labels);
+  add(this->Impl->Styles);
+  add(this->Impl->Blocks);
+  add(this->Impl->Transfer);
+  add(this->Impl->OpaqueDepth);
+  for (const CutTextures& cut : this->Impl->Cuts)
+  {
+    add(cut.Page);
+    add(cut.Atlas);
+  }
+  return bytes;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolumeCutRayCaster* scene, vtkMatrix4x4* worldToNDC,
+  int vtkNotUsed(x0), int vtkNotUsed(y0), int width, int height, const float* opaqueDepth)
+{
+  this->LastErrorMessage.clear();
+  this->NumberOfBricksUploaded = 0;
+  Internals& impl = *this->Impl;
+  if (!window || !scene || !worldToNDC || width < 1 || height < 1)
+  {
+    this->LastErrorMessage = "no OpenGL window, scene or camera";
+    return false;
+  }
+  vtkVolumeCutRayCaster::SceneView view;
+  if (!scene->UpdateScene(view))
+  {
+    this->LastErrorMessage = "the scene cannot be rendered (see the error above)";
+    return false;
+  }
+  const int cuts = static_cast<int>(view.CutFields.size());
+  if (cuts > MaximumNumberOfCutFields)
+  {
+    this->LastErrorMessage = "more than " + std::to_string(MaximumNumberOfCutFields) + " cut fields";
+    return false;
+  }
+  if (impl.Context && impl.Context != window)
+  {
+    impl.Release(impl.Context);
+  }
+  impl.Context = window;
+
+  GLint maximum3D = 0;
+  glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &maximum3D);
+  const int* dims = view.Dimensions;
+  if (dims[0] > maximum3D || dims[1] > maximum3D || dims[2] > maximum3D)
+  {
+    std::ostringstream message;
+    message << "the volume (" << dims[0] << " x " << dims[1] << " x " << dims[2] << ") exceeds this GPU's 3D texture limit of "
+            << maximum3D;
+    this->LastErrorMessage = message.str();
+    return false;
+  }
+
+  // Anatomy and labels: when the CT or its grid changed.
+  if (!impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion || impl.SceneVersion != view.Version)
+  {
+    if (!impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion)
+    {
+      impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, view.Values);
+      if (!impl.Anatomy)
+      {
+        this->LastErrorMessage = "the CT does not fit in GPU memory as a float 3D texture";
+        return false;
+      }
+      impl.AnatomyVersion = view.AnatomyVersion;
+    }
+    const size_t voxels = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
+    std::vector<float> labels(view.Labels ? voxels : 8, 0.f);
+    if (view.Labels)
+    {
+      std::copy(view.Labels, view.Labels + voxels, labels.begin());
+    }
+    impl.Labels = view.Labels ? Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, labels.data())
+                              : Internals::Texture3D(window, 2, 2, 2, 1, labels.data());
+    std::vector<float> styles(8 * view.Styles.size());
+    const int styleCount = static_cast<int>(view.Styles.size());
+    for (int label = 0; label < styleCount; ++label)
+    {
+      std::copy(view.Styles[label].begin(), view.Styles[label].begin() + 4, styles.begin() + 4 * label);
+      std::copy(view.Styles[label].begin() + 4, view.Styles[label].end(), styles.begin() + 4 * (styleCount + label));
+    }
+    impl.Styles = Internals::Texture2D(window, styleCount, 2, 4, styles.data());
+    const int* bd = view.BlockDimensions;
+    const size_t blocks = static_cast<size_t>(bd[0]) * bd[1] * bd[2];
+    std::vector<float> blockData(2 * blocks);
+    for (size_t n = 0; n < blocks; ++n)
+    {
+      blockData[2 * n] = view.BlockOccupied[n] ? 1.f : 0.f;
+      blockData[2 * n + 1] = std::isfinite(view.BlockLipschitz[n]) ? view.BlockLipschitz[n] : 1e30f;
+    }
+    impl.Blocks = Internals::Texture3D(window, bd[0], bd[1], bd[2], 2, blockData.data());
+    std::vector<float> transfer(4 * std::max(view.TableSize, 2), 0.f);
+    if (view.ColorTable && view.OpacityTable)
+    {
+      for (int n = 0; n < view.TableSize; ++n)
+      {
+        std::copy(view.ColorTable + 3 * n, view.ColorTable + 3 * n + 3, transfer.begin() + 4 * n);
+        transfer[4 * n + 3] = view.OpacityTable[n];
+      }
+    }
+    impl.Transfer = Internals::Texture2D(window, std::max(view.TableSize, 2), 1, 4, transfer.data());
+    if (!impl.Labels || !impl.Styles || !impl.Blocks || !impl.Transfer)
+    {
+      this->LastErrorMessage = "the label map or lookup tables do not fit in GPU memory";
+      impl.Anatomy = nullptr;
+      return false;
+    }
+    impl.SceneVersion = view.Version;
+  }
+
+  // Cut fields: only modified bricks travel.
+  for (int n = 0; n < cuts; ++n)
+  {
+    const vtkIdType uploaded = impl.UpdateCut(window, impl.Cuts[n], view.CutFields[n]);
+    if (uploaded < 0)
+    {
+      this->LastErrorMessage = "cut field " + std::to_string(n) + " does not fit in GPU memory";
+      return false;
+    }
+    this->NumberOfBricksUploaded += uploaded;
+  }
+  this->TotalNumberOfBricksUploaded += this->NumberOfBricksUploaded;
+
+  std::vector<float> depth(static_cast<size_t>(width) * height, 1.f);
+  if (opaqueDepth)
+  {
+    std::copy(opaqueDepth, opaqueDepth + depth.size(), depth.begin());
+  }
+  impl.OpaqueDepth = Internals::Texture2D(window, width, height, 1, depth.data());
+  if (!impl.OpaqueDepth)
+  {
+    this->LastErrorMessage = "no memory for the depth texture";
+    return false;
+  }
+
+  if (impl.ShaderCuts != cuts || !impl.Quad)
+  {
+    if (impl.Quad)
+    {
+      impl.Quad->ReleaseGraphicsResources(window);
+    }
+    const std::string fragment = FragmentShader(cuts);
+    impl.Quad.reset(new vtkOpenGLQuadHelper(
+      window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), fragment.c_str(), ""));
+    impl.ShaderCuts = cuts;
+  }
+  if (!impl.Quad->Program || !impl.Quad->Program->GetCompiled())
+  {
+    this->LastErrorMessage = "the ray-casting shader does not compile on this OpenGL context";
+    return false;
+  }
+  window->GetShaderCache()->ReadyShaderProgram(impl.Quad->Program);
+  vtkShaderProgram* program = impl.Quad->Program;
+
+  vtkVolumeCutRayCaster* s = scene;
+  float matrix[16];
+  double ndcToWorld[16];
+  double worldToNDCValues[16];
+  {
+    vtkNew<vtkMatrix4x4> inverse;
+    vtkMatrix4x4::Invert(worldToNDC, inverse);
+    std::copy(&inverse->Element[0][0], &inverse->Element[0][0] + 16, ndcToWorld);
+    std::copy(&worldToNDC->Element[0][0], &worldToNDC->Element[0][0] + 16, worldToNDCValues);
+  }
+  ColumnMajor(ndcToWorld, matrix);
+  program->SetUniformMatrix4x4("ndcToWorld", matrix);
+  ColumnMajor(worldToNDCValues, matrix);
+  program->SetUniformMatrix4x4("worldToNDC", matrix);
+  ColumnMajor(view.WorldToIJK, matrix);
+  program->SetUniformMatrix4x4("worldToIJK", matrix);
+  ColumnMajor(view.IJKToWorld, matrix);
+  program->SetUniformMatrix4x4("ijkToWorld", matrix);
+  float normal3[9];
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      normal3[column * 3 + row] = static_cast<float>(view.NormalMatrix[row * 4 + column]);
+    }
+  }
+  program->SetUniformMatrix3x3("normalMatrix", normal3);
+  const float dimensions[3] = { float(dims[0]), float(dims[1]), float(dims[2]) };
+  program->SetUniform3f("dimensionsF", dimensions);
+  const float blockDimensions[3] = { float(view.BlockDimensions[0]), float(view.BlockDimensions[1]), float(view.BlockDimensions[2]) };
+  program->SetUniform3f("blockDimensionsF", blockDimensions);
+  const float size[2] = { float(width), float(height) };
+  program->SetUniform2f("viewportSize", size);
+  program->SetUniformi("hasLabels", view.Labels ? 1 : 0);
+  program->SetUniformi("styleCount", static_cast<int>(view.Styles.size()));
+  program->SetUniformf("sampleDistance", static_cast<float>(s->GetSampleDistance()));
+  program->SetUniformf("gradientStep", static_cast<float>(s->GetGradientStep()));
+  program->SetUniformf("ambientK", static_cast<float>(s->GetAmbient()));
+  program->SetUniformf("diffuseK", static_cast<float>(s->GetDiffuse()));
+  program->SetUniformf("specularK", static_cast<float>(s->GetSpecular()));
+  program->SetUniformf("specularPower", static_cast<float>(s->GetSpecularPower()));
+  program->SetUniformi("anyIso", view.AnyIsoSegment ? 1 : 0);
+  program->SetUniformf("minimumIso", static_cast<float>(std::isfinite(view.MinimumIso) ? view.MinimumIso : 1e30));
+  program->SetUniformi("blendMode", s->GetBlendMode());
+  program->SetUniformf("unitDistance", static_cast<float>(s->GetScalarOpacityUnitDistance()));
+  const float range[2] = { float(view.TableRange[0]), float(view.TableRange[1]) };
+  program->SetUniform2f("tableRange", range);
+  program->SetUniformi("tableSize", std::max(view.TableSize, 2));
+  program->SetUniformi("thinBone", s->GetThinBoneShading() ? 1 : 0);
+  program->SetUniformf("thinBoneThickness", static_cast<float>(s->GetThinBoneThickness()));
+  program->SetUniformi("refinements", view.MaximumRefinements);
+  const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
+  float planes[6][4] = {};
+  for (int p = 0; p < planeCount; ++p)
+  {
+    for (int c = 0; c < 4; ++c)
+    {
+      planes[p][c] = static_cast<float>(view.Planes[p][c]);
+    }
+  }
+  program->SetUniformi("planeCount", planeCount);
+  program->SetUniform4fv("planes", 6, planes);
+
+  std::vector<vtkTextureObject*> active;
+  auto bindTexture = [&](vtkTextureObject* texture, const char* name) {
+    texture->Activate();
+    program->SetUniformi(name, texture->GetTextureUnit());
+    active.push_back(texture);
+  };
+  bindTexture(impl.Anatomy, "anatomyTexture");
+  bindTexture(impl.Labels, "labelTexture");
+  bindTexture(impl.Styles, "styleTexture");
+  bindTexture(impl.Blocks, "blockTexture");
+  bindTexture(impl.OpaqueDepth, "opaqueDepthTexture");
+  bindTexture(impl.Transfer, "transferTexture");
+  for (int n = 0; n < cuts; ++n)
+  {
+    const std::string index = std::to_string(n);
+    CutTextures& cut = impl.Cuts[n];
+    bindTexture(cut.Page, ("cutPage" + index).c_str());
+    bindTexture(cut.Atlas, ("cutAtlas" + index).c_str());
+    const float cutDimensions[3] = { float(cut.Dimensions[0]), float(cut.Dimensions[1]), float(cut.Dimensions[2]) };
+    program->SetUniform3f(("cutDimensionsF" + index).c_str(), cutDimensions);
+    program->SetUniformi(("cutSlots" + index).c_str(), cut.SlotsPerAxis);
+    vtkNew<vtkMatrix4x4> subToWorld;
+    view.CutFields[n]->GetSubVoxelIJKToRAS(subToWorld);
+    vtkNew<vtkMatrix4x4> worldToSub;
+    vtkMatrix4x4::Invert(subToWorld, worldToSub);
+    ColumnMajor(&worldToSub->Element[0][0], matrix);
+    program->SetUniformMatrix4x4(("worldToSub" + index).c_str(), matrix);
+    program->SetUniformf(("cutQuantum" + index).c_str(), static_cast<float>(view.CutFields[n]->GetQuantum()));
+    double spacing[3];
+    view.CutFields[n]->GetSubVoxelSpacing(spacing);
+    program->SetUniformf(("cutStep" + index).c_str(), static_cast<float>(0.25 * std::min({ spacing[0], spacing[1], spacing[2] })));
+  }
+
+  vtkOpenGLState* state = window->GetState();
+  vtkOpenGLState::ScopedglDepthMask depthMask(state);
+  vtkOpenGLState::ScopedglDepthFunc depthFunc(state);
+  vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(state);
+  vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
+  vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
+  state->vtkglEnable(GL_BLEND);
+  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+  state->vtkglEnable(GL_DEPTH_TEST);
+  // Rays already stop at opaque geometry; the depth written is the surface's.
+  state->vtkglDepthFunc(GL_ALWAYS);
+  state->vtkglDepthMask(GL_TRUE);
+  impl.Quad->Render();
+  for (vtkTextureObject* texture : active)
+  {
+    texture->Deactivate();
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfBricksUploaded: " << this->NumberOfBricksUploaded << " (total " << this->TotalNumberOfBricksUploaded
+     << ")\n";
+  os << indent << "TextureMemorySize: " << this->GetTextureMemorySize() << "\n";
+  os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
+}
