@@ -197,8 +197,11 @@ struct vtkVolumeCutRayCaster::Internals
     return static_cast<float>(c0 + f[2] * (c1 - c0));
   }
 
-  // The visible label with the largest trilinear weight among the cell's
-  // corners, and that weight (the label's interpolated indicator).
+  // The segment label with the largest trilinear weight among the cell's
+  // corners (hidden segments included, background not), and that weight (the
+  // label's interpolated indicator). Where two segments meet, their border is
+  // where their weights are equal, a smooth surface; where a segment meets
+  // the background, the CT's iso-surface (or the indicator at 0.5) decides.
   int DominantLabel(const double p[3], double& weight) const
   {
     int base[3];
@@ -217,7 +220,7 @@ struct vtkVolumeCutRayCaster::Internals
       const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
       const int label =
         this->Labels[c[0] + static_cast<vtkIdType>(this->Dimensions[0]) * (c[1] + static_cast<vtkIdType>(this->Dimensions[1]) * c[2])];
-      if (label == 0 || label >= static_cast<int>(this->Styles.size()) || this->Styles[label].Opacity <= 0.f)
+      if (label == 0)
       {
         continue;
       }
@@ -284,9 +287,9 @@ struct vtkVolumeCutRayCaster::Internals
     }
     double weight = 0.0;
     const int label = this->DominantLabel(p, weight);
-    if (label == 0)
+    if (label == 0 || label >= static_cast<int>(this->Styles.size()) || this->Styles[label].Opacity <= 0.f)
     {
-      return 0;
+      return 0; // background, or a hidden segment
     }
     const SegmentStyle& style = this->Styles[label];
     const bool inside = style.Shape ? weight >= 0.5 : value >= style.Iso;
@@ -531,10 +534,10 @@ struct vtkVolumeCutRayCaster::Internals
 };
 
 //------------------------------------------------------------------------------
-double vtkVolumeCutRayCaster::Internals::MeasureThickness(int object, const double index[3], const double normalWorld[3]) const
+double vtkVolumeCutRayCaster::Internals::MeasureThickness(int vtkNotUsed(object), const double index[3], const double normalWorld[3]) const
 {
-  // March inward (against the outward normal) until the visible material of
-  // this object ends, in steps of a quarter voxel, up to the threshold.
+  // March inward (against the outward normal) until the visible material
+  // ends, in steps of a quarter voxel, up to the threshold.
   double inward[3] = { -normalWorld[0], -normalWorld[1], -normalWorld[2] };
   double inwardIndex[3];
   TransformVector(this->WorldToIJK, inward, inwardIndex);
@@ -555,8 +558,10 @@ double vtkVolumeCutRayCaster::Internals::MeasureThickness(int object, const doub
         return this->ThinBoneThickness;
       }
     }
+    // Bone is bone whatever its segment (cortical over trabecular): the wall
+    // ends where no visible material is left.
     this->EvaluateObject(s);
-    if (s.Object != object || !this->Visible(s))
+    if (!this->Visible(s))
     {
       return travelled;
     }

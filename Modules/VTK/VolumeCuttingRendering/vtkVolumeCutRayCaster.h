@@ -250,7 +250,7 @@ protected:
   int BlendMode = IsoSurfaceBlend;
   double IsoValue = 300.0;
   double SampleDistance = 0.5;
-  double GradientStep = 0.3;
+  double GradientStep = 1.0;
   double ScalarOpacityUnitDistance = 1.0;
   bool ThinBoneShading = false;
   double ThinBoneThickness = 1.0;

@@ -239,7 +239,17 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   window->GetZbufferData(x0, y0, x0 + width - 1, y0 + height - 1, opaqueDepth.data());
 
   int path = CPUPath;
-  if (this->RequestedRenderPath != CPUPath)
+  const char* rendererName = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string glRenderer = rendererName ? rendererName : "";
+  // A software rasterizer runs the shader on the CPU, one fragment at a time:
+  // the multithreaded CPU reference is faster there.
+  const bool softwareRenderer = glRenderer.find("llvmpipe") != std::string::npos || glRenderer.find("softpipe") != std::string::npos ||
+    glRenderer.find("SwiftShader") != std::string::npos || glRenderer.find("swrast") != std::string::npos;
+  if (this->RequestedRenderPath == AutomaticPath && softwareRenderer)
+  {
+    impl.FallbackReason = "the OpenGL renderer (" + glRenderer + ") is a software rasterizer, where the CPU reference is faster";
+  }
+  else if (this->RequestedRenderPath != CPUPath)
   {
     if (impl.OpenGLRayCaster->Render(window, caster, worldToNDC, x0, y0, width, height, opaqueDepth.data()))
     {

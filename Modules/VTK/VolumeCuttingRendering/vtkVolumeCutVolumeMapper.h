@@ -9,7 +9,8 @@
  * the scene (label map and segment appearances, cut fields, iso-value,
  * thin-bone shading) and is the CPU reference. Each frame it runs the GLSL
  * implementation (vtkVolumeCutOpenGLRayCaster) when the OpenGL context can
- * run it, and otherwise casts the rays on the CPU and draws the image; both
+ * run it on graphics hardware, and otherwise casts the rays on the CPU and
+ * draws the image; both
  * write the depth of the first visible surface, so other actors (the tool
  * glyph, models, markups) composite correctly, and both stop rays at opaque
  * geometry already drawn. GetLastRenderPath() says which ran, and a change of
@@ -45,7 +46,9 @@ public:
 
   enum RenderPaths
   {
-    /// The GPU where the context runs the shader, the CPU otherwise.
+    /// The GPU where the context runs the shader on graphics hardware; the
+    /// CPU otherwise (a software rasterizer such as Mesa's llvmpipe runs the
+    /// shader, but slower than the multithreaded CPU reference).
     AutomaticPath = 0,
     GPUPath = 1,
     CPUPath = 2

@@ -124,7 +124,7 @@ int dominantLabel(vec3 p, out float weight)
   for (int corner = 0; corner < 8; ++corner)
   {
     int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
-    if (label == 0 || label >= styleCount || styleColor(label).a <= 0.0)
+    if (label == 0)
     {
       continue;
     }
@@ -181,7 +181,7 @@ int objectAt(vec3 p, out float value)
   }
   float weight;
   int label = dominantLabel(p, weight);
-  if (label == 0)
+  if (label == 0 || label >= styleCount || styleColor(label).a <= 0.0)
   {
     return 0;
   }
@@ -412,7 +412,7 @@ float measureThickness(int object, vec3 index, vec3 normalWorld)
       return thinBoneThickness;
     }
     evaluateObject(s);
-    if (s.object != object || !visible(s))
+    if (!visible(s))
     {
       return travelled;
     }

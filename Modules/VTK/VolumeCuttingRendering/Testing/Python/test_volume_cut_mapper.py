@@ -410,11 +410,21 @@ def test_gpu_path_falls_back_to_the_cpu_with_a_reason():
     renderer.AddVolume(volume)
     renderer.ResetCamera()
     window.Render()
+    # Automatic: the CPU draws, and the log says why (a software rasterizer
+    # such as llvmpipe, or a volume beyond the 3D texture limit).
     assert mapper.GetLastRenderPath() == vc.vtkVolumeCutVolumeMapper.CPUPath
-    assert "3D texture limit" in mapper.GetGPUFallbackReason()
-    assert any("Rendering cuts on the CPU" in m for m in log.messages)
+    reason = mapper.GetGPUFallbackReason()
+    assert "3D texture limit" in reason or "software rasterizer" in reason
+    assert sum("Rendering cuts on the CPU" in m for m in log.messages) == 1
     depth, _ = read_window(window, width)
     assert np.any(depth < 1.0)
+    window.Render()
+    assert sum("Rendering cuts on the CPU" in m for m in log.messages) == 1  # once, not every frame
+    # The GPU path asked for explicitly: a clear error, nothing drawn, no crash.
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
+    window.Render()
+    assert mapper.GetLastRenderPath() == 0
+    assert "3D texture limit" in log.messages[-1]
     # Without input: nothing drawn, no crash (the renderer may not even call it).
     empty_mapper = vc.vtkVolumeCutVolumeMapper()
     empty_volume = vtk.vtkVolume()
