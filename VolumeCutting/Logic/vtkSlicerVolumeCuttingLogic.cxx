@@ -479,24 +479,42 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
     field->SetProtectedLabels(nullptr);
     return;
   }
-  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  vtkNew<vtkImageData> labels;
+  for (const std::string& id : CreateSegmentLabelMap(cutNode, protectedIds, labels))
+  {
+    vtkWarningMacro("UpdateProtection: segment '" << id << "' has no labelmap on the anatomy grid; tools are not kept out of it");
+  }
+  field->SetProtectedLabels(labels);
+}
+
+//----------------------------------------------------------------------------
+std::vector<std::string> vtkSlicerVolumeCuttingLogic::CreateSegmentLabelMap(
+  vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds, vtkImageData* labels)
+{
+  std::vector<std::string> missing;
+  vtkMRMLScalarVolumeNode* anatomy = cutNode ? cutNode->GetAnatomyVolumeNode() : nullptr;
+  vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
+  if (!labels || !anatomy || !anatomy->GetImageData())
+  {
+    return segmentIds;
+  }
   vtkNew<vtkOrientedImageData> anatomyGeometry;
   GetVolumeGeometry(anatomy, anatomyGeometry);
-  vtkNew<vtkImageData> labels;
+  labels->Initialize();
   labels->SetExtent(anatomy->GetImageData()->GetExtent());
-  labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
   labels->GetPointData()->GetScalars()->FillComponent(0, 0.0);
-  unsigned char* labelVoxels = static_cast<unsigned char*>(labels->GetScalarPointer());
+  unsigned short* labelVoxels = static_cast<unsigned short*>(labels->GetScalarPointer());
   const int* dims = labels->GetDimensions();
-  for (size_t index = 0; index < protectedIds.size() && index < 255; ++index)
+  for (size_t index = 0; index < segmentIds.size(); ++index)
   {
     vtkNew<vtkOrientedImageData> segmentMask;
     vtkNew<vtkOrientedImageData> mask;
-    if (!segmentationNode->GetSegmentation()->GetSegment(protectedIds[index])
-        || !segmentationNode->GetBinaryLabelmapRepresentation(protectedIds[index], segmentMask)
-        || !vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
+    if (index >= 65535 || !segmentationNode || !segmentationNode->GetSegmentation()->GetSegment(segmentIds[index]) ||
+      !segmentationNode->GetBinaryLabelmapRepresentation(segmentIds[index], segmentMask) ||
+      !vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
     {
-      vtkWarningMacro("UpdateProtection: segment '" << protectedIds[index] << "' has no labelmap on the anatomy grid; tools are not kept out of it");
+      missing.push_back(segmentIds[index]);
       continue;
     }
     int extent[6];
@@ -509,13 +527,13 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
         {
           if (mask->GetScalarComponentAsDouble(i, j, k, 0) > 0.0)
           {
-            labelVoxels[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<unsigned char>(index + 1);
+            labelVoxels[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<unsigned short>(index + 1);
           }
         }
       }
     }
   }
-  field->SetProtectedLabels(labels);
+  return missing;
 }
 
 //----------------------------------------------------------------------------
@@ -550,31 +568,42 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetStrokeField(vtkMRMLVolumeCutN
 }
 
 //----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::NotifyCutModified(vtkMRMLVolumeCutNode* cutNode, bool changed)
+{
+  // Views re-render; they find the modified bricks by their stamps.
+  if (changed && cutNode)
+  {
+    cutNode->InvokeCustomModifiedEvent(vtkMRMLVolumeCutNode::CutModifiedEvent);
+  }
+  return changed;
+}
+
+//----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
   vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return field && field->CutCapsule(p0, p1, radius);
+  return NotifyCutModified(cutNode, field && field->CutCapsule(p0, p1, radius));
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
   vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return field && field->RestoreCapsule(p0, p1, radius);
+  return NotifyCutModified(cutNode, field && field->RestoreCapsule(p0, p1, radius));
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
   vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return field && field->CutToolSweep(tool, pose0, pose1);
+  return NotifyCutModified(cutNode, field && field->CutToolSweep(tool, pose0, pose1));
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
   vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return field && field->RestoreToolSweep(tool, pose0, pose1);
+  return NotifyCutModified(cutNode, field && field->RestoreToolSweep(tool, pose0, pose1));
 }
 
 //----------------------------------------------------------------------------
@@ -593,14 +622,14 @@ bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
 bool vtkSlicerVolumeCuttingLogic::UndoStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  return field && field->Undo();
+  return NotifyCutModified(cutNode, field && field->Undo());
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RedoStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  return field && field->Redo();
+  return NotifyCutModified(cutNode, field && field->Redo());
 }
 
 //----------------------------------------------------------------------------
@@ -763,7 +792,7 @@ bool vtkSlicerVolumeCuttingLogic::DrillWithMaterialRemoval(vtkMRMLVolumeCutNode*
     return false;
   }
   remover->SetBurrType(burrType);
-  return remover->Drill(center, axis, radius, dt);
+  return NotifyCutModified(cutNode, remover->Drill(center, axis, radius, dt));
 }
 
 //----------------------------------------------------------------------------

@@ -148,6 +148,15 @@ public:
   /// Total removed volume (mm^3) of the node's cut field.
   double GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode);
 
+  /**
+   * Label map of the given segments on the anatomy's voxel grid (unsigned
+   * short, IJK geometry: label k + 1 for segmentIds[k], later segments win
+   * where they overlap). Returns the IDs that could not be rasterised.
+   * The displayable manager colours the cut rendering with it.
+   */
+  static std::vector<std::string> CreateSegmentLabelMap(
+    vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds, vtkImageData* labels);
+
 protected:
   vtkSlicerVolumeCuttingLogic();
   ~vtkSlicerVolumeCuttingLogic() override;
@@ -180,6 +189,8 @@ protected:
 
   /// Segments kept out of cutting, in label order (label n is element n - 1).
   static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
+  /// Invokes the node's CutModifiedEvent when \a changed; returns \a changed.
+  static bool NotifyCutModified(vtkMRMLVolumeCutNode* cutNode, bool changed);
 
   /// Give the field the node's shielded segments as labels on the anatomy grid.
   void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);

@@ -129,6 +129,9 @@ void vtkMRMLVolumeCutNode::WriteXML(ostream& of, int nIndent)
   vtkMRMLWriteXMLStdStringVectorMacro(protectedSegmentIDs, ProtectedSegmentIDs, std::vector);
   vtkMRMLWriteXMLStdStringVectorMacro(cuttableSegmentIDs, CuttableSegmentIDs, std::vector);
   vtkMRMLWriteXMLIntMacro(subVoxelFactor, SubVoxelFactor);
+  vtkMRMLWriteXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
+  vtkMRMLWriteXMLBooleanMacro(thinBoneShading, ThinBoneShading);
+  vtkMRMLWriteXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
   vtkMRMLWriteXMLEndMacro();
 }
 
@@ -141,6 +144,9 @@ void vtkMRMLVolumeCutNode::ReadXMLAttributes(const char** atts)
   vtkMRMLReadXMLStdStringVectorMacro(protectedSegmentIDs, ProtectedSegmentIDs, std::vector);
   vtkMRMLReadXMLStdStringVectorMacro(cuttableSegmentIDs, CuttableSegmentIDs, std::vector);
   vtkMRMLReadXMLIntMacro(subVoxelFactor, SubVoxelFactor);
+  vtkMRMLReadXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
+  vtkMRMLReadXMLBooleanMacro(thinBoneShading, ThinBoneShading);
+  vtkMRMLReadXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
   vtkMRMLReadXMLEndMacro();
 }
 
@@ -170,6 +176,9 @@ void vtkMRMLVolumeCutNode::CopyContent(vtkMRMLNode* anode, bool deepCopy /*=true
   vtkMRMLCopyStdStringVectorMacro(ProtectedSegmentIDs);
   vtkMRMLCopyStdStringVectorMacro(CuttableSegmentIDs);
   vtkMRMLCopyIntMacro(SubVoxelFactor);
+  vtkMRMLCopyFloatMacro(SurfaceIsoValue);
+  vtkMRMLCopyBooleanMacro(ThinBoneShading);
+  vtkMRMLCopyFloatMacro(ThinBoneThickness);
   vtkMRMLCopyEndMacro();
 }
 
@@ -181,6 +190,9 @@ void vtkMRMLVolumeCutNode::PrintSelf(ostream& os, vtkIndent indent)
   vtkMRMLPrintStdStringVectorMacro(CuttableSegmentIDs, std::vector);
   vtkMRMLPrintStdStringVectorMacro(ProtectedSegmentIDs, std::vector);
   vtkMRMLPrintIntMacro(SubVoxelFactor);
+  vtkMRMLPrintFloatMacro(SurfaceIsoValue);
+  vtkMRMLPrintBooleanMacro(ThinBoneShading);
+  vtkMRMLPrintFloatMacro(ThinBoneThickness);
   vtkMRMLPrintEndMacro();
 }
 

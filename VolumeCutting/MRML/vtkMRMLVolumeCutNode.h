@@ -66,7 +66,10 @@ public:
     /// renderer inputs) can be updated.
     InputDataModifiedEvent = 27300,
     /// Invoked when the role of any segment changes.
-    SegmentRolesModifiedEvent
+    SegmentRolesModifiedEvent,
+    /// Invoked (by the logic, on the thread that cuts through it) when the
+    /// removed region changed: views re-render the modified bricks.
+    CutModifiedEvent
   };
 
   ///@{
@@ -132,6 +135,22 @@ public:
   void SetSubVoxelFactor(int factor);
   vtkGetMacro(SubVoxelFactor, int);
   static bool IsValidSubVoxelFactor(int factor);
+
+  ///@{
+  /**
+   * How the 3D view shows the cut anatomy (vtkMRMLVolumeCutDisplayableManager):
+   * the CT value (HU) of the surface of cuttable segments (and of the bone
+   * when there is no segmentation), and thin-bone shading (Morris et al.):
+   * bone thinner than ThinBoneThickness (mm) shown red and translucent.
+   */
+  vtkSetMacro(SurfaceIsoValue, double);
+  vtkGetMacro(SurfaceIsoValue, double);
+  vtkSetMacro(ThinBoneShading, bool);
+  vtkGetMacro(ThinBoneShading, bool);
+  vtkBooleanMacro(ThinBoneShading, bool);
+  vtkSetClampMacro(ThinBoneThickness, double, 0.05, 20.0);
+  vtkGetMacro(ThinBoneThickness, double);
+  ///@}
   ///@}
 
 protected:
@@ -152,6 +171,9 @@ protected:
   std::vector<std::string> CuttableSegmentIDs;
   std::vector<std::string> ProtectedSegmentIDs;
   int SubVoxelFactor{ 2 };
+  double SurfaceIsoValue{ 300.0 };
+  bool ThinBoneShading{ false };
+  double ThinBoneThickness{ 1.0 };
 };
 
 #endif

@@ -10,3 +10,4 @@ from .vtkVolumeCuttingCore import *  # noqa: F401,F403
 from .vtkVolumeCuttingRendering import *  # noqa: F401,F403
 from .vtkSlicerVolumeCuttingModuleMRML import *  # noqa: F401,F403
 from .vtkSlicerVolumeCuttingModuleLogic import *  # noqa: F401,F403
+from .vtkSlicerVolumeCuttingModuleMRMLDisplayableManager import *  # noqa: F401,F403

@@ -1,0 +1,292 @@
+/*==============================================================================
+
+  VolumeCutting
+  Licensed under the Apache License, Version 2.0 (the "License");
+
+==============================================================================*/
+
+#include "vtkMRMLVolumeCutDisplayableManager.h"
+
+#include "vtkMRMLVolumeCutNode.h"
+#include "vtkSlicerVolumeCuttingLogic.h"
+#include "vtkVolumeCutField.h"
+#include "vtkVolumeCutRayCaster.h"
+#include "vtkVolumeCutVolumeMapper.h"
+
+#include <vtkMRMLScalarVolumeNode.h>
+#include <vtkMRMLScene.h>
+#include <vtkMRMLSegmentationDisplayNode.h>
+#include <vtkMRMLSegmentationNode.h>
+#include <vtkSegment.h>
+#include <vtkSegmentation.h>
+
+#include <vtkImageData.h>
+#include <vtkIntArray.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
+#include <vtkVolume.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+vtkStandardNewMacro(vtkMRMLVolumeCutDisplayableManager);
+
+//---------------------------------------------------------------------------
+struct vtkMRMLVolumeCutDisplayableManager::Internals
+{
+  struct Pipeline
+  {
+    vtkSmartPointer<vtkVolume> Volume;
+    vtkSmartPointer<vtkVolumeCutVolumeMapper> Mapper;
+    vtkSmartPointer<vtkImageData> Labels;
+    vtkVolumeCutField* Field = nullptr;
+    std::string LabelSource;
+  };
+  std::map<vtkMRMLVolumeCutNode*, Pipeline> Pipelines;
+};
+
+//---------------------------------------------------------------------------
+vtkMRMLVolumeCutDisplayableManager::vtkMRMLVolumeCutDisplayableManager()
+  : Impl(new Internals)
+{
+}
+
+//---------------------------------------------------------------------------
+vtkMRMLVolumeCutDisplayableManager::~vtkMRMLVolumeCutDisplayableManager() = default;
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Cut nodes shown: " << this->Impl->Pipelines.size() << "\n";
+}
+
+//---------------------------------------------------------------------------
+vtkVolume* vtkMRMLVolumeCutDisplayableManager::GetVolumeActor(vtkMRMLVolumeCutNode* cutNode)
+{
+  auto found = this->Impl->Pipelines.find(cutNode);
+  return found == this->Impl->Pipelines.end() ? nullptr : found->second.Volume.GetPointer();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::SetMRMLSceneInternal(vtkMRMLScene* newScene)
+{
+  vtkNew<vtkIntArray> events;
+  events->InsertNextValue(vtkMRMLScene::NodeAddedEvent);
+  events->InsertNextValue(vtkMRMLScene::NodeRemovedEvent);
+  events->InsertNextValue(vtkMRMLScene::EndCloseEvent);
+  events->InsertNextValue(vtkMRMLScene::EndBatchProcessEvent);
+  this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneNodeAdded(vtkMRMLNode* node)
+{
+  vtkMRMLVolumeCutNode* cutNode = vtkMRMLVolumeCutNode::SafeDownCast(node);
+  if (!cutNode || this->GetMRMLScene()->IsBatchProcessing())
+  {
+    return;
+  }
+  vtkNew<vtkIntArray> events;
+  events->InsertNextValue(vtkCommand::ModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::InputDataModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::SegmentRolesModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::CutModifiedEvent);
+  vtkObserveMRMLNodeEventsMacro(cutNode, events);
+  this->UpdatePipeline(cutNode);
+  this->RequestRender();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
+{
+  vtkMRMLVolumeCutNode* cutNode = vtkMRMLVolumeCutNode::SafeDownCast(node);
+  if (!cutNode)
+  {
+    return;
+  }
+  vtkUnObserveMRMLNodeMacro(cutNode);
+  auto found = this->Impl->Pipelines.find(cutNode);
+  if (found != this->Impl->Pipelines.end())
+  {
+    this->GetRenderer()->RemoveVolume(found->second.Volume);
+    this->Impl->Pipelines.erase(found);
+    this->RequestRender();
+  }
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneEndClose()
+{
+  for (auto& entry : this->Impl->Pipelines)
+  {
+    this->GetRenderer()->RemoveVolume(entry.second.Volume);
+  }
+  this->Impl->Pipelines.clear();
+  this->RequestRender();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::UpdateFromMRMLScene()
+{
+  vtkMRMLScene* scene = this->GetMRMLScene();
+  if (!scene)
+  {
+    return;
+  }
+  std::vector<vtkMRMLNode*> nodes;
+  scene->GetNodesByClass("vtkMRMLVolumeCutNode", nodes);
+  for (vtkMRMLNode* node : nodes)
+  {
+    if (this->Impl->Pipelines.find(vtkMRMLVolumeCutNode::SafeDownCast(node)) == this->Impl->Pipelines.end())
+    {
+      vtkNew<vtkIntArray> events;
+      events->InsertNextValue(vtkCommand::ModifiedEvent);
+      events->InsertNextValue(vtkMRMLVolumeCutNode::InputDataModifiedEvent);
+      events->InsertNextValue(vtkMRMLVolumeCutNode::SegmentRolesModifiedEvent);
+      events->InsertNextValue(vtkMRMLVolumeCutNode::CutModifiedEvent);
+      vtkObserveMRMLNodeEventsMacro(node, events);
+    }
+    this->UpdatePipeline(vtkMRMLVolumeCutNode::SafeDownCast(node));
+  }
+  this->RequestRender();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::ProcessMRMLNodesEvents(vtkObject* caller, unsigned long event, void* callData)
+{
+  vtkMRMLVolumeCutNode* cutNode = vtkMRMLVolumeCutNode::SafeDownCast(caller);
+  if (!cutNode)
+  {
+    this->Superclass::ProcessMRMLNodesEvents(caller, event, callData);
+    return;
+  }
+  if (event != vtkMRMLVolumeCutNode::CutModifiedEvent)
+  {
+    this->UpdatePipeline(cutNode);
+  }
+  else
+  {
+    // The cut field may have been created by this stroke.
+    auto found = this->Impl->Pipelines.find(cutNode);
+    if (found == this->Impl->Pipelines.end() || found->second.Field != cutNode->GetCutField())
+    {
+      this->UpdatePipeline(cutNode);
+    }
+  }
+  this->RequestRender();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* node)
+{
+  vtkRenderer* renderer = this->GetRenderer();
+  if (!node || !renderer)
+  {
+    return;
+  }
+  auto& pipeline = this->Impl->Pipelines[node];
+  if (!pipeline.Volume)
+  {
+    pipeline.Volume = vtkSmartPointer<vtkVolume>::New();
+    pipeline.Mapper = vtkSmartPointer<vtkVolumeCutVolumeMapper>::New();
+    pipeline.Volume->SetMapper(pipeline.Mapper);
+    pipeline.Volume->SetPickable(false);
+    renderer->AddVolume(pipeline.Volume);
+  }
+  vtkMRMLScalarVolumeNode* anatomy = node->GetAnatomyVolumeNode();
+  if (!anatomy || !anatomy->GetImageData())
+  {
+    pipeline.Volume->SetVisibility(false);
+    return;
+  }
+  vtkVolumeCutVolumeMapper* mapper = pipeline.Mapper;
+  vtkVolumeCutRayCaster* caster = mapper->GetRayCaster();
+  if (mapper->GetInput() != anatomy->GetImageData())
+  {
+    mapper->SetInputData(anatomy->GetImageData());
+  }
+  // Slicer's image data have unit spacing and no origin: IJK-to-RAS places them.
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  vtkMatrix4x4* current = pipeline.Volume->GetUserMatrix();
+  bool sameMatrix = current != nullptr;
+  for (int element = 0; element < 16 && sameMatrix; ++element)
+  {
+    sameMatrix = current->GetElement(element / 4, element % 4) == ijkToRas->GetElement(element / 4, element % 4);
+  }
+  if (!sameMatrix)
+  {
+    pipeline.Volume->SetUserMatrix(ijkToRas);
+  }
+  if (pipeline.Field != node->GetCutField())
+  {
+    caster->RemoveAllCutFields();
+    if (node->GetCutField())
+    {
+      caster->AddCutField(node->GetCutField());
+    }
+    pipeline.Field = node->GetCutField();
+  }
+  caster->SetIsoValue(node->GetSurfaceIsoValue());
+  caster->SetThinBoneShading(node->GetThinBoneShading());
+  caster->SetThinBoneThickness(node->GetThinBoneThickness());
+
+  // Segments visible in 3D, in their colours.
+  vtkMRMLSegmentationNode* segmentation = node->GetSegmentationNode();
+  vtkMRMLSegmentationDisplayNode* display =
+    segmentation ? vtkMRMLSegmentationDisplayNode::SafeDownCast(segmentation->GetDisplayNode()) : nullptr;
+  std::vector<std::string> shown;
+  if (segmentation && display)
+  {
+    for (const std::string& id : segmentation->GetSegmentation()->GetSegmentIDs())
+    {
+      if (display->GetSegmentVisibility3D(id) && display->GetSegmentOpacity3D(id) > 0.0)
+      {
+        shown.push_back(id);
+      }
+    }
+  }
+  std::ostringstream source;
+  if (segmentation)
+  {
+    source << segmentation->GetID() << "@" << segmentation->GetSegmentation()->GetMTime() << "/" << anatomy->GetImageData()->GetMTime();
+  }
+  for (const std::string& id : shown)
+  {
+    source << "|" << id;
+  }
+  if (shown.empty())
+  {
+    caster->SetLabelMap(nullptr);
+    caster->RemoveAllSegmentAppearances();
+    pipeline.Labels = nullptr;
+    pipeline.LabelSource.clear();
+  }
+  else
+  {
+    if (pipeline.LabelSource != source.str())
+    {
+      pipeline.Labels = vtkSmartPointer<vtkImageData>::New();
+      vtkSlicerVolumeCuttingLogic::CreateSegmentLabelMap(node, shown, pipeline.Labels);
+      caster->SetLabelMap(pipeline.Labels);
+      pipeline.LabelSource = source.str();
+    }
+    caster->RemoveAllSegmentAppearances();
+    for (size_t index = 0; index < shown.size(); ++index)
+    {
+      const std::string& id = shown[index];
+      double color[3] = { 1.0, 1.0, 1.0 };
+      segmentation->GetSegmentation()->GetSegment(id)->GetColor(color);
+      const double opacity = display->GetSegmentOpacity3D(id);
+      const double iso = node->IsSegmentCuttable(id) ? node->GetSurfaceIsoValue() : std::numeric_limits<double>::quiet_NaN();
+      caster->SetSegmentAppearance(static_cast<int>(index + 1), color, opacity, iso);
+    }
+  }
+  pipeline.Volume->SetVisibility(true);
+}
