@@ -37,6 +37,15 @@ def check_outputs(summary, out_dir):
     assert pixels.shape == (240, 320, 3)
     # The bone must fill a good part of the view, and not all of it.
     assert 0.05 < foreground_fraction(pixels) < 0.95
+    # Drawn by the product's mapper, before and after cutting, and zoomed on a cut edge.
+    assert summary["rendering"]["path"] in ("CPU", "GPU")
+    assert summary["rendering"]["displayable_manager"] == "vtkMRMLVolumeCutDisplayableManager"
+    before = read_png(out_dir / "cut_before.png")
+    assert before.shape == pixels.shape
+    changed = (np.abs(before - pixels).sum(axis=2) > 30).mean()
+    assert 0.0005 < changed < 0.5  # the cavity, not the whole view
+    zoom = read_png(out_dir / "cut_edge_zoom.png")
+    assert foreground_fraction(zoom) > 0.05
     reloaded = HeadlessSlicer()
     reloaded.load_bundle(out_dir / "scene.mrb")
     cut = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")

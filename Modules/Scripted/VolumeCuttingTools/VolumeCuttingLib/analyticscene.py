@@ -82,11 +82,13 @@ class CubeScene:
 
     def intensities(self) -> vtk.vtkImageData:
         n = self.dimensions
-        index = np.arange(n) * self.spacing
-        z, y, x = np.meshgrid(index, index, index, indexing="ij")
-        points = np.stack([x, y, z], axis=-1)
-        width = self.ramp_voxels * self.spacing
-        values = self.bone * np.clip(0.5 - self.cube_distance(points) / width, 0.0, 1.0)
+        # Separable: the box distance from per-axis offsets, broadcast (float32).
+        q = (np.abs(np.arange(n, dtype=np.float32) * self.spacing - np.float32(self.center[0])) - np.float32(self.half_size))
+        qz, qy, qx = q[:, None, None], q[None, :, None], q[None, None, :]
+        outside = np.sqrt(np.maximum(qx, 0) ** 2 + np.maximum(qy, 0) ** 2 + np.maximum(qz, 0) ** 2)
+        inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0)
+        width = np.float32(self.ramp_voxels * self.spacing)
+        values = np.float32(self.bone) * np.clip(np.float32(0.5) - (outside + inside) / width, 0, 1)
         image = vtk.vtkImageData()
         image.SetDimensions(n, n, n)
         array = numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True)
@@ -101,7 +103,7 @@ class CubeScene:
         import slicer_volumecutting as vc
 
         cut = vc.vtkVolumeCutField()
-        cut.SetMaximumStrokeLength(1000.0)
+        cut.SetMaximumStrokeLength(1.0e6)
         if not cut.Initialize([self.dimensions] * 3, self.ijk_to_ras(), factor):
             raise RuntimeError("cut field initialisation failed")
         self.apply_cuts(cut)
@@ -111,7 +113,7 @@ class CubeScene:
         for sphere in self.spheres:
             cut.CutCapsule(sphere.center, sphere.center, sphere.radius)
         for cylinder in self.cylinders:
-            reach = 4.0 * self.dimensions * self.spacing
+            reach = 2.0 * self.dimensions * self.spacing
             direction = np.asarray(cylinder.direction, float)
             direction /= np.linalg.norm(direction)
             p0 = np.asarray(cylinder.point) - reach * direction
@@ -230,12 +232,17 @@ class CubeScene:
         return np.where(valid, classes, BACKGROUND)
 
 
-def default_scene() -> CubeScene:
-    """The issue's scene: cuts across a corner, two edges and into a face."""
-    scene = CubeScene()
+def default_scene(dimensions: int = 64) -> CubeScene:
+    """The issue's scene: cuts across a corner, two edges and into a face.
+
+    Larger ``dimensions`` scale the whole scene (cube, cuts) with the grid, at
+    the same voxel size, for performance measurements.
+    """
+    scale = dimensions / 64.0
+    scene = CubeScene(dimensions=dimensions, half_size_voxels=int(round(14 * scale)))
     c = scene.center
     h = scene.half_size
-    s = scene.spacing
+    s = scene.spacing * scale
     scene.spheres = [
         Sphere(tuple(c + [h - 0.37 * s, h - 0.61 * s, h + 0.23 * s]), 5.3 * s),  # a corner
         Sphere(tuple(c + [h + 0.81 * s, 0.17 * s, h - 1.93 * s]), 4.1 * s),  # an edge

@@ -102,6 +102,10 @@ class ThreeDView:
         self.interactor = vtk.vtkRenderWindowInteractor()
         self.interactor.SetRenderWindow(self.render_window)
         self.displayable_managers = factory.InstantiateDisplayableManagers(self.renderer)
+        # Desktop Slicer creates ours by name through its object factory; here
+        # it is added to the view's group directly.
+        self.volume_cut_displayable_manager = slicer.vtkMRMLVolumeCutDisplayableManager()
+        self.displayable_managers.AddDisplayableManager(self.volume_cut_displayable_manager)
         self.displayable_managers.SetMRMLDisplayableNode(self.view_node)
 
     def look_at(self, focal_point, direction, distance, view_up=(0.0, 0.0, 1.0)):

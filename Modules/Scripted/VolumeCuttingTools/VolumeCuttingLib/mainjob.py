@@ -21,6 +21,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import slicer
 
 from . import drilling, headct, phantom
@@ -30,6 +31,7 @@ from .application import HeadlessSlicer
 # the structures whose injury is the complication the trainee must avoid.
 # The skin and soft tissue over the mastoid are incised and reflected first.
 PHANTOM_CUTTABLE_SEGMENTS = ("SoftTissue", "MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
+PHANTOM_BONE_SEGMENTS = ("MastoidCortex", "MastoidBone", "FacialCanalWall")
 PHANTOM_PROTECTED_SEGMENTS = (
     "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
 
@@ -118,6 +120,27 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
                                           surface_radius=7.0, depth=8.0, burr_radius=2.0)
     else:
         plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *HEAD_CT_RIGHT_MASTOID_YZ))
+    # The cut anatomy as the product shows it: through the adaptive multivolume
+    # ray-cast mapper (vtkMRMLVolumeCutDisplayableManager), before and after.
+    # The segmentation's own surfaces stay hidden; its segments colour the view.
+    display = roles_segmentation.GetDisplayNode()
+    display.SetVisibility3D(False)
+    if anatomy_segmentation is not None:
+        # Bone and the structures at risk; soft tissue and air stay hidden.
+        for segment_id in anatomy_segmentation.GetSegmentation().GetSegmentIDs():
+            display.SetSegmentVisibility3D(segment_id, segment_id in PHANTOM_PROTECTED_SEGMENTS
+                                           or segment_id in PHANTOM_BONE_SEGMENTS)
+    # Bone surface at 300 HU; bone thinner than 1 mm over what lies behind it
+    # shows red and translucent (Morris et al.), as a surgeon drilling sees it.
+    cut_node.SetSurfaceIsoValue(300.0)
+    cut_node.SetThinBoneShading(True)
+    cut_node.SetThinBoneThickness(1.0)
+    view = application.create_3d_view(*size)
+    lateral_camera(view, bone, None)
+    with timer.measure("first_frame_s"):
+        view.render()
+    before_path = view.screenshot(out_dir / "cut_before.png")
+
     with timer.measure("drilling_s"):
         drilled = drilling.drill(logic, cut_node, plan)
     removed_per_segment = {
@@ -137,23 +160,27 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         raise RuntimeError("writing removed.stl failed (see the log)")
     drilled_ct = logic.ExportDrilledVolume(cut_node, -1000.0, None)
 
-    with timer.measure("surface_s"):
-        bone.CreateClosedSurfaceRepresentation()
-        if anatomy_segmentation is not None:
-            # Show the structures the user must see through the bone.
-            anatomy_segmentation.CreateClosedSurfaceRepresentation()
-            display = anatomy_segmentation.GetDisplayNode()
-            for segment_id in anatomy_segmentation.GetSegmentation().GetSegmentIDs():
-                display.SetSegmentVisibility(segment_id, segment_id in PHANTOM_PROTECTED_SEGMENTS)
-            bone.GetDisplayNode().SetOpacity3D(0.35)
-        else:
-            bone.GetDisplayNode().SetOpacity3D(0.6)
-
-    view = application.create_3d_view(*size)
-    lateral_camera(view, bone, None)
-    with timer.measure("first_frame_s"):
+    with timer.measure("cut_frame_s"):
         view.render()
     image_path = view.screenshot(out_dir / "3d.png")
+    mapper = view.volume_cut_displayable_manager.GetVolumeActor(cut_node).GetMapper()
+    rendering = {
+        "displayable_manager": "vtkMRMLVolumeCutDisplayableManager",
+        "mapper": mapper.GetClassName(),
+        "path": mapper.GetLastRenderPathAsString(),
+        "gpu_fallback_reason": mapper.GetGPUFallbackReason(),
+        "frame_time_s": round(mapper.GetLastFrameTime(), 4),
+    }
+    # Zoom onto the rim of the cavity, where the cut meets the cortex: the
+    # edge is drawn exactly, not as voxel stairs.
+    entry = np.asarray(plan.entry, dtype=float)
+    bounds = [0.0] * 6
+    volume.GetRASBounds(bounds)
+    lateral = 1.0 if entry[0] > (bounds[0] + bounds[1]) / 2.0 else -1.0
+    rim = entry + np.array([0.0, 0.0, 0.85 * plan.surface_radius])
+    view.look_at(rim, direction=(lateral * 0.8, 0.0, 0.6), distance=18.0, view_up=(0.0, 0.0, 1.0))
+    view.render()
+    zoom_path = view.screenshot(out_dir / "cut_edge_zoom.png")
     renderer = view.renderer_description()
 
     with timer.measure("save_scene_s"):
@@ -193,7 +220,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
             "drilled_ct": drilled_ct.GetName(),
         },
         "renderer": renderer,
+        "rendering": rendering,
         "image": str(image_path),
+        "image_before_cutting": str(before_path),
+        "image_cut_edge_zoom": str(zoom_path),
         "scene_bundle": str(bundle),
         "timings": timer.seconds,
     }

@@ -1,0 +1,115 @@
+"""The 3D view shows a volume-cut node through the multivolume mapper, and follows its cuts.
+
+Real scene, real logic, Slicer's displayable-manager group and an offscreen
+render window; depths are checked against the exact geometry of the analytic
+cube (VolumeCuttingLib.analyticscene).
+"""
+
+import math
+
+import numpy as np
+import pytest
+import slicer
+import vtk
+from vtkmodules.util import numpy_support
+
+from VolumeCuttingLib import analyticscene, nodes
+from VolumeCuttingLib.application import HeadlessSlicer
+
+
+@pytest.fixture()
+def session():
+    application = HeadlessSlicer()
+    scene = analyticscene.CubeScene(dimensions=40, half_size_voxels=10)
+    array = numpy_support.vtk_to_numpy(scene.intensities().GetPointData().GetScalars()).reshape((40, 40, 40))
+    ijk_to_ras = nodes.vtk_matrix_to_numpy(scene.ijk_to_ras())
+    volume = nodes.create_scalar_volume_node(application.scene, array.astype(np.int16), ijk_to_ras, "Cube")
+    logic = application.volume_cutting_logic
+    bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.0)
+    cut_node = logic.AddVolumeCutNode(volume, bone)
+    cut_node.SetCuttableSegmentIDs([logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()])
+    cut_node.SetSurfaceIsoValue(scene.iso_value())
+    view = application.create_3d_view(64, 64)
+    # Looking straight down at the top face.
+    center = scene.center
+    camera = view.renderer.GetActiveCamera()
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(*(center + [0.0, 0.0, 60.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(30.0, 100.0)
+    yield application, scene, volume, cut_node, view
+    view.close()
+
+
+def surface_z(view, x, y):
+    depth = vtk.vtkFloatArray()
+    view.render_window.GetZbufferData(x, y, x, y, depth)
+    renderer = view.renderer
+    renderer.SetDisplayPoint(x + 0.5, y + 0.5, depth.GetValue(0))
+    renderer.DisplayToWorld()
+    world = renderer.GetWorldPoint()
+    return world[2] / world[3], depth.GetValue(0)
+
+
+def test_view_shows_the_cut_node_and_follows_cuts(session):
+    application, scene, volume, cut_node, view = session
+    manager = view.volume_cut_displayable_manager
+    actor = manager.GetVolumeActor(cut_node)
+    assert actor is not None and actor.GetVisibility()
+    mapper = actor.GetMapper()
+    assert mapper.GetInput() is volume.GetImageData()
+    view.render()
+    assert mapper.GetLastRenderPath() != 0
+    top = scene.center[2] + scene.half_size
+    z, depth = surface_z(view, 32, 32)
+    assert depth < 1.0
+    assert z == pytest.approx(top, abs=0.02)
+
+    # A cut through the logic re-renders the view with the pit.
+    logic = application.volume_cutting_logic
+    events = []
+    cut_node.AddObserver(slicer.vtkMRMLVolumeCutNode.CutModifiedEvent, lambda caller, event: events.append(event))
+    pit = [scene.center[0], scene.center[1], top]
+    assert logic.CutSphereSweep(cut_node, pit, pit, 2.5)
+    assert events
+    view.render()
+    z, _ = surface_z(view, 32, 32)
+    # The pixel's ray is a little off the pit's axis.
+    renderer = view.renderer
+    renderer.SetDisplayPoint(32.5, 32.5, 0.0)
+    renderer.DisplayToWorld()
+    near = renderer.GetWorldPoint()
+    off_axis = math.hypot(near[0] / near[3] - pit[0], near[1] / near[3] - pit[1])
+    assert z == pytest.approx(top - math.sqrt(2.5**2 - off_axis**2), abs=0.02)
+
+    # Undo through the logic puts the face back.
+    assert logic.UndoStroke(cut_node)
+    view.render()
+    z, _ = surface_z(view, 32, 32)
+    assert z == pytest.approx(top, abs=0.02)
+
+    # Removing the node removes its volume from the view.
+    application.scene.RemoveNode(cut_node)
+    assert manager.GetVolumeActor(cut_node) is None
+    assert view.renderer.GetVolumes().GetNumberOfItems() == 0
+
+
+def test_rendering_settings_are_saved_with_the_node():
+    scene = slicer.vtkMRMLScene()
+    scene.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
+    node = scene.AddNewNodeByClass("vtkMRMLVolumeCutNode")
+    node.SetSurfaceIsoValue(412.5)
+    node.SetThinBoneShading(True)
+    node.SetThinBoneThickness(1.75)
+    scene.SetSaveToXMLString(1)
+    scene.Commit()
+    xml = scene.GetSceneXMLString()
+    reloaded = slicer.vtkMRMLScene()
+    reloaded.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
+    reloaded.SetLoadFromXMLString(1)
+    reloaded.SetSceneXMLString(xml)
+    reloaded.Import()
+    copy = reloaded.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    assert copy.GetSurfaceIsoValue() == pytest.approx(412.5)
+    assert copy.GetThinBoneShading()
+    assert copy.GetThinBoneThickness() == pytest.approx(1.75)
