@@ -8,6 +8,8 @@ Modules:
     drilling: scripted drilling paths (cortical mastoidectomy) replayed through the logic.
     mainjob: the README's main job.
     benchmarks: the benchmark harness (one JSON per area).
+    analyticscene: the mapper's accuracy scene (a cut cube) and its exact ray tracing and metrics.
+    mapperbenchmarks: the ``mapper`` benchmark area (accuracy and frame times vs VTK's stock mapper).
 
 Submodules are not imported here so that the numpy-only parts stay usable
 without VTK or Slicer.

@@ -179,7 +179,9 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
     lateral = 1.0 if entry[0] > (bounds[0] + bounds[1]) / 2.0 else -1.0
     rim = entry + np.array([0.0, 0.0, 0.85 * plan.surface_radius])
     view.look_at(rim, direction=(lateral * 0.8, 0.0, 0.6), distance=18.0, view_up=(0.0, 0.0, 1.0))
+    cut_node.SetThinBoneShading(False)  # the edge itself, in the bone's colour
     view.render()
+    cut_node.SetThinBoneShading(True)
     zoom_path = view.screenshot(out_dir / "cut_edge_zoom.png")
     renderer = view.renderer_description()
 
