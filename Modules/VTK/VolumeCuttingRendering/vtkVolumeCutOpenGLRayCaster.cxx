@@ -604,24 +604,31 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     program->SetUniformf(("cutStep" + index).c_str(), static_cast<float>(0.25 * std::min({ spacing[0], spacing[1], spacing[2] })));
   }
 
+  DrawSurfaceQuad(window, impl.Quad.get());
+  for (vtkTextureObject* texture : active)
+  {
+    texture->Deactivate();
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLQuadHelper* quad)
+{
   vtkOpenGLState* state = window->GetState();
   vtkOpenGLState::ScopedglDepthMask depthMask(state);
   vtkOpenGLState::ScopedglDepthFunc depthFunc(state);
   vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(state);
   vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
   vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
+  // Premultiplied colour over what is drawn; rays already stopped at opaque
+  // geometry, so the depth written (the surface's) always wins.
   state->vtkglEnable(GL_BLEND);
   state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
   state->vtkglEnable(GL_DEPTH_TEST);
-  // Rays already stop at opaque geometry; the depth written is the surface's.
   state->vtkglDepthFunc(GL_ALWAYS);
   state->vtkglDepthMask(GL_TRUE);
-  impl.Quad->Render();
-  for (vtkTextureObject* texture : active)
-  {
-    texture->Deactivate();
-  }
-  return true;
+  quad->Render();
 }
 
 //------------------------------------------------------------------------------

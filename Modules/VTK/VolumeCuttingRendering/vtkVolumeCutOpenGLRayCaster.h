@@ -30,6 +30,7 @@
 #include <string>  // For the error message
 
 class vtkMatrix4x4;
+class vtkOpenGLQuadHelper;
 class vtkOpenGLRenderWindow;
 class vtkVolumeCutRayCaster;
 class vtkWindow;
@@ -64,6 +65,13 @@ public:
   size_t GetTextureMemorySize() const;
 
   void ReleaseGraphicsResources(vtkWindow* window);
+
+  /**
+   * Draw a full-viewport quad whose fragments carry premultiplied colour and
+   * gl_FragDepth: blended over the framebuffer, writing depth (the state is
+   * restored after). Both paths draw their images this way.
+   */
+  static void DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLQuadHelper* quad);
 
 protected:
   vtkVolumeCutOpenGLRayCaster();

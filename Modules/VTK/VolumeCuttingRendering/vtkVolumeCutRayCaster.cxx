@@ -174,16 +174,22 @@ struct vtkVolumeCutRayCaster::Internals
   std::vector<PlaneEquation> PlaneEquations;
 
   // ---- field evaluation -------------------------------------------------
-  float Interpolate(const double p[3]) const
+  // The cell holding p (clamped to the volume) and p's offsets in it.
+  void CellOf(const double p[3], int base[3], double f[3]) const
   {
-    int base[3];
-    double f[3];
     for (int axis = 0; axis < 3; ++axis)
     {
       const double x = std::min(std::max(p[axis], 0.0), double(this->Dimensions[axis] - 1));
       base[axis] = std::min(static_cast<int>(x), this->Dimensions[axis] - 2);
       f[axis] = x - base[axis];
     }
+  }
+
+  float Interpolate(const double p[3]) const
+  {
+    int base[3];
+    double f[3];
+    this->CellOf(p, base, f);
     const vtkIdType sx = 1;
     const vtkIdType sy = this->Dimensions[0];
     const vtkIdType sz = static_cast<vtkIdType>(this->Dimensions[0]) * this->Dimensions[1];
@@ -206,12 +212,7 @@ struct vtkVolumeCutRayCaster::Internals
   {
     int base[3];
     double f[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      const double x = std::min(std::max(p[axis], 0.0), double(this->Dimensions[axis] - 1));
-      base[axis] = std::min(static_cast<int>(x), this->Dimensions[axis] - 2);
-      f[axis] = x - base[axis];
-    }
+    this->CellOf(p, base, f);
     int labels[8];
     double weights[8];
     int count = 0;
@@ -257,12 +258,7 @@ struct vtkVolumeCutRayCaster::Internals
   {
     int base[3];
     double f[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      const double x = std::min(std::max(p[axis], 0.0), double(this->Dimensions[axis] - 1));
-      base[axis] = std::min(static_cast<int>(x), this->Dimensions[axis] - 2);
-      f[axis] = x - base[axis];
-    }
+    this->CellOf(p, base, f);
     double value = 0.0;
     for (int corner = 0; corner < 8; ++corner)
     {
@@ -1752,6 +1748,30 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
         }
       }
     });
+  }
+
+  // The rectangle of pixels this call changes.
+  this->UpdatedRegion[0] = 0;
+  this->UpdatedRegion[1] = 0;
+  this->UpdatedRegion[2] = width - 1;
+  this->UpdatedRegion[3] = height - 1;
+  if (localized)
+  {
+    int region[4] = { width, height, -1, -1 };
+    for (int y = 0; y < height; ++y)
+    {
+      for (int x = 0; x < width; ++x)
+      {
+        if (mask[static_cast<vtkIdType>(y) * width + x])
+        {
+          region[0] = std::min(region[0], x);
+          region[1] = std::min(region[1], y);
+          region[2] = std::max(region[2], x);
+          region[3] = std::max(region[3], y);
+        }
+      }
+    }
+    std::copy(region, region + 4, this->UpdatedRegion);
   }
 
   std::atomic<vtkIdType> cast(0);

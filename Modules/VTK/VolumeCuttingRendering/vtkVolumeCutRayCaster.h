@@ -206,6 +206,10 @@ public:
   /// Whether the last Render was a localized update.
   vtkGetMacro(LastRenderWasLocalized, bool);
 
+  /// Pixel rectangle (x0, y0, x1, y1, inclusive) the last Render changed;
+  /// empty (x1 < x0) when it cast no ray.
+  vtkGetVector4Macro(UpdatedRegion, int);
+
   struct Internals;
 
 #ifndef __VTK_WRAP__
@@ -260,6 +264,7 @@ protected:
   double SpecularPower = 20.0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;
+  int UpdatedRegion[4] = { 0, 0, -1, -1 };
 
   bool PrepareScene(bool& sceneChanged);
 

@@ -304,7 +304,28 @@ bool vtkVolumeCutVolumeMapper::DrawCPUImage(vtkRenderer* vtkNotUsed(renderer), i
     }
     return texture->Create2DFromRaw(w, h, components, VTK_FLOAT, const_cast<float*>(data));
   };
-  if (!makeTexture(impl.Color, 4, caster->GetColorBuffer(), width, height) ||
+  int region[4];
+  caster->GetUpdatedRegion(region);
+  const bool sameSize = impl.Color && static_cast<int>(impl.Color->GetWidth()) == width &&
+    static_cast<int>(impl.Color->GetHeight()) == height && caster->GetLastRenderWasLocalized();
+  if (sameSize)
+  {
+    // A localized update: only the changed rectangle travels to the GPU.
+    if (region[2] >= region[0] && region[3] >= region[1])
+    {
+      glPixelStorei(GL_UNPACK_ROW_LENGTH, width);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+      const size_t offset = static_cast<size_t>(region[1]) * width + region[0];
+      impl.Color->Bind();
+      glTexSubImage2D(GL_TEXTURE_2D, 0, region[0], region[1], region[2] - region[0] + 1, region[3] - region[1] + 1, GL_RGBA, GL_FLOAT,
+        caster->GetColorBuffer() + 4 * offset);
+      impl.Depth->Bind();
+      glTexSubImage2D(GL_TEXTURE_2D, 0, region[0], region[1], region[2] - region[0] + 1, region[3] - region[1] + 1, GL_RED, GL_FLOAT,
+        caster->GetDepthBuffer() + offset);
+      glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    }
+  }
+  else if (!makeTexture(impl.Color, 4, caster->GetColorBuffer(), width, height) ||
     !makeTexture(impl.Depth, 1, caster->GetDepthBuffer(), width, height))
   {
     vtkErrorMacro("Render: no GPU memory for a " << width << " x " << height << " image");
@@ -325,18 +346,7 @@ bool vtkVolumeCutVolumeMapper::DrawCPUImage(vtkRenderer* vtkNotUsed(renderer), i
   impl.Depth->Activate();
   impl.Quad->Program->SetUniformi("colorTexture", impl.Color->GetTextureUnit());
   impl.Quad->Program->SetUniformi("depthTexture", impl.Depth->GetTextureUnit());
-  vtkOpenGLState* state = window->GetState();
-  vtkOpenGLState::ScopedglDepthMask depthMask(state);
-  vtkOpenGLState::ScopedglDepthFunc depthFunc(state);
-  vtkOpenGLState::ScopedglBlendFuncSeparate blendFunc(state);
-  vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
-  vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
-  state->vtkglEnable(GL_BLEND);
-  state->vtkglBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-  state->vtkglEnable(GL_DEPTH_TEST);
-  state->vtkglDepthFunc(GL_ALWAYS);
-  state->vtkglDepthMask(GL_TRUE);
-  impl.Quad->Render();
+  vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(window, impl.Quad.get());
   impl.Color->Deactivate();
   impl.Depth->Deactivate();
   return true;

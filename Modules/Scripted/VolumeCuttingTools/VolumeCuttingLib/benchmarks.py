@@ -431,9 +431,16 @@ def cutfield(repeats: int) -> list[dict]:
     return results
 
 
+def mapper(repeats: int) -> list[dict]:
+    from . import mapperbenchmarks
+
+    return mapperbenchmarks.mapper(repeats, machine_description)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
+    "mapper": mapper,
 }
 
 

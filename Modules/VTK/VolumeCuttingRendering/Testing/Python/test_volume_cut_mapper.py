@@ -96,13 +96,7 @@ def test_whole_voxel_masking_misses_the_edges_the_field_places(scene, intensitie
     """The same metric detects the staircase of masking by whole voxels (the baseline)."""
     width = 160
     cut = scene.cut_field(2)
-    fraction = vtk.vtkImageData()
-    cut.ExportRemovedFraction(fraction)
-    values = numpy_support.vtk_to_numpy(intensities.GetPointData().GetScalars()).copy()
-    values[numpy_support.vtk_to_numpy(fraction.GetPointData().GetScalars()) >= 0.5] = 0.0
-    masked = vtk.vtkImageData()
-    masked.SetDimensions(intensities.GetDimensions())
-    masked.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values, deep=True))
+    masked = A.CubeScene.masked_intensities(intensities, cut)
     caster, matrix = cast(scene, masked, None, width)
     depth = image_array(caster.GetDepthImage, width, width, 1)
     reference = A.exact_reference(scene, matrix, width, width, supersampling=4)
