@@ -427,3 +427,32 @@ def test_gpu_path_falls_back_to_the_cpu_with_a_reason():
     window.Render()
     assert empty_mapper.GetLastRenderPath() == 0
     assert math.isfinite(mapper.GetLastFrameTime())
+
+
+@pytest.mark.parametrize("path", ["CPUPath", "GPUPath"])
+def test_stereo_draws_each_eye_with_its_own_camera(scene, intensities, path):
+    """Split-viewport stereo: both eyes show the cut cube, from slightly different places."""
+    width = 64
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(2 * width, width)
+    window.SetStereoCapableWindow(1)
+    window.SetStereoTypeToSplitViewportHorizontal()
+    window.StereoRenderOn()
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    camera = A.make_camera(scene, 2.0, width, width)
+    camera.SetEyeAngle(6.0)
+    renderer.SetActiveCamera(camera)
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    mapper.SetRequestedRenderPath(getattr(vc.vtkVolumeCutVolumeMapper, path))
+    window.Render()
+    assert mapper.GetLastRenderPath() == getattr(vc.vtkVolumeCutVolumeMapper, path)
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, 2 * width - 1, width - 1, 1, rgba)
+    pixels = numpy_support.vtk_to_numpy(rgba).reshape(width, 2 * width, 4).astype(int)
+    left, right = pixels[:, :width, :3], pixels[:, width:, :3]
+    background = pixels[0, 0, :3]
+    for eye in (left, right):
+        assert (np.abs(eye - background).sum(axis=2) > 30).mean() > 0.2
+    assert np.abs(left - right).sum(axis=2).astype(bool).mean() > 0.01  # parallax
