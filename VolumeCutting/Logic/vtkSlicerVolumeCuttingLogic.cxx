@@ -30,6 +30,9 @@
 #include <vtkBinaryLabelmapToClosedSurfaceConversionRule.h>
 #include <vtkClosedSurfaceToBinaryLabelmapConversionRule.h>
 #include <vtkClosedSurfaceToFractionalLabelmapConversionRule.h>
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkSegmentationConverter.h>
 #include <vtkFractionalLabelmapToClosedSurfaceConversionRule.h>
 #include <vtkOrientedImageData.h>
 #include <vtkOrientedImageDataResample.h>
@@ -534,6 +537,59 @@ std::vector<std::string> vtkSlicerVolumeCuttingLogic::CreateSegmentLabelMap(
     }
   }
   return missing;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::CreateSegmentFractionOnAnatomyGrid(
+  vtkMRMLVolumeCutNode* cutNode, const std::string& segmentId, vtkImageData* fraction)
+{
+  vtkMRMLScalarVolumeNode* anatomy = cutNode ? cutNode->GetAnatomyVolumeNode() : nullptr;
+  vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
+  const std::string name = vtkSegmentationConverter::GetSegmentationFractionalLabelmapRepresentationName();
+  vtkSegment* segment = segmentationNode ? segmentationNode->GetSegmentation()->GetSegment(segmentId) : nullptr;
+  vtkOrientedImageData* source = segment ? vtkOrientedImageData::SafeDownCast(segment->GetRepresentation(name)) : nullptr;
+  if (!fraction || !anatomy || !anatomy->GetImageData() || !source || !source->GetPointData()->GetScalars())
+  {
+    return false;
+  }
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  GetVolumeGeometry(anatomy, anatomyGeometry);
+  vtkNew<vtkOrientedImageData> resampled;
+  // Linear: the fractions of a segment resampled stay fractions.
+  if (!vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(source, anatomyGeometry, resampled, true))
+  {
+    return false;
+  }
+  // Slicer stores fractions as [minimum, maximum] of the representation's
+  // scalar range (-108..108 for its char labelmaps); padding is outside.
+  double range[2] = { -108.0, 108.0 };
+  vtkDoubleArray* scalarRange = vtkDoubleArray::SafeDownCast(
+    source->GetFieldData()->GetAbstractArray(vtkSegmentationConverter::GetScalarRangeFieldName()));
+  if (scalarRange && scalarRange->GetNumberOfValues() == 2)
+  {
+    range[0] = scalarRange->GetValue(0);
+    range[1] = scalarRange->GetValue(1);
+  }
+  fraction->Initialize();
+  fraction->SetExtent(anatomy->GetImageData()->GetExtent());
+  fraction->AllocateScalars(VTK_FLOAT, 1);
+  fraction->GetPointData()->GetScalars()->FillComponent(0, 0.0);
+  float* values = static_cast<float*>(fraction->GetScalarPointer());
+  const int* dims = fraction->GetDimensions();
+  int extent[6];
+  resampled->GetExtent(extent);
+  for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+  {
+    for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+    {
+      for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
+      {
+        const double value = (resampled->GetScalarComponentAsDouble(i, j, k, 0) - range[0]) / (range[1] - range[0]);
+        values[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<float>(std::min(1.0, std::max(0.0, value)));
+      }
+    }
+  }
+  return true;
 }
 
 //----------------------------------------------------------------------------

@@ -157,6 +157,13 @@ public:
   static std::vector<std::string> CreateSegmentLabelMap(
     vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds, vtkImageData* labels);
 
+  /**
+   * The fraction (0..1 float, anatomy grid, IJK geometry) of each anatomy
+   * voxel inside a segment that has a fractional labelmap representation.
+   * Returns false (nothing written) when the segment has none.
+   */
+  static bool CreateSegmentFractionOnAnatomyGrid(vtkMRMLVolumeCutNode* cutNode, const std::string& segmentId, vtkImageData* fraction);
+
 protected:
   vtkSlicerVolumeCuttingLogic();
   ~vtkSlicerVolumeCuttingLogic() override;

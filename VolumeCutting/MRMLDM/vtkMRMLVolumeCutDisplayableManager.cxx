@@ -46,6 +46,7 @@ struct vtkMRMLVolumeCutDisplayableManager::Internals
     vtkSmartPointer<vtkImageData> Labels;
     vtkVolumeCutField* Field = nullptr;
     std::string LabelSource;
+    std::string FractionSource;
   };
   std::map<vtkMRMLVolumeCutNode*, Pipeline> Pipelines;
 };
@@ -265,8 +266,13 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
   {
     caster->SetLabelMap(nullptr);
     caster->RemoveAllSegmentAppearances();
+    for (int label = 1; label <= 16 && caster->GetNumberOfSegmentFractions() > 0; ++label)
+    {
+      caster->SetSegmentFraction(label, nullptr);
+    }
     pipeline.Labels = nullptr;
     pipeline.LabelSource.clear();
+    pipeline.FractionSource.clear();
   }
   else
   {
@@ -280,6 +286,15 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
     caster->RemoveAllSegmentAppearances();
     for (size_t index = 0; index < shown.size(); ++index)
     {
+      // Segments with fractional labelmaps (up to 16) are placed at sub-voxel
+      // accuracy; the others by their binary labelmap.
+      if (pipeline.LabelSource != pipeline.FractionSource)
+      {
+        vtkNew<vtkImageData> fraction;
+        const bool hasFraction = index < 16 &&
+          vtkSlicerVolumeCuttingLogic::CreateSegmentFractionOnAnatomyGrid(node, shown[index], fraction);
+        caster->SetSegmentFraction(static_cast<int>(index + 1), hasFraction ? fraction.GetPointer() : nullptr);
+      }
       const std::string& id = shown[index];
       double color[3] = { 1.0, 1.0, 1.0 };
       segmentation->GetSegmentation()->GetSegment(id)->GetColor(color);
@@ -287,6 +302,7 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
       const double iso = node->IsSegmentCuttable(id) ? node->GetSurfaceIsoValue() : std::numeric_limits<double>::quiet_NaN();
       caster->SetSegmentAppearance(static_cast<int>(index + 1), color, opacity, iso);
     }
+    pipeline.FractionSource = pipeline.LabelSource;
   }
   pipeline.Volume->SetVisibility(true);
 }

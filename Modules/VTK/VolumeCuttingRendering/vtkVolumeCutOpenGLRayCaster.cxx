@@ -159,6 +159,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkOpenGLRenderWindow* Context = nullptr;
   vtkSmartPointer<vtkTextureObject> Anatomy;
   vtkSmartPointer<vtkTextureObject> Labels;
+  vtkSmartPointer<vtkTextureObject> Fractions;
   vtkSmartPointer<vtkTextureObject> Styles;
   vtkSmartPointer<vtkTextureObject> Blocks;
   vtkSmartPointer<vtkTextureObject> Transfer;
@@ -171,7 +172,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
 
   void Release(vtkWindow* window)
   {
-    for (vtkTextureObject* texture : { this->Anatomy.GetPointer(), this->Labels.GetPointer(), this->Styles.GetPointer(),
+    for (vtkTextureObject* texture : { this->Anatomy.GetPointer(), this->Labels.GetPointer(), this->Fractions.GetPointer(), this->Styles.GetPointer(),
            this->Blocks.GetPointer(), this->Transfer.GetPointer(), this->OpaqueDepth.GetPointer() })
     {
       if (texture)
@@ -179,7 +180,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
         texture->ReleaseGraphicsResources(window);
       }
     }
-    this->Anatomy = this->Labels = this->Styles = this->Blocks = this->Transfer = this->OpaqueDepth = nullptr;
+    this->Anatomy = this->Labels = this->Fractions = this->Styles = this->Blocks = this->Transfer = this->OpaqueDepth = nullptr;
     for (CutTextures& cut : this->Cuts)
     {
       if (cut.Page)
@@ -353,6 +354,7 @@ size_t vtkVolumeCutOpenGLRayCaster::GetTextureMemorySize() const
   };
   add(this->Impl->Anatomy);
   add(this->Impl->Labels);
+  add(this->Impl->Fractions);
   add(this->Impl->Styles);
   add(this->Impl->Blocks);
   add(this->Impl->Transfer);
@@ -381,6 +383,11 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   if (!scene->UpdateScene(view))
   {
     this->LastErrorMessage = "the scene cannot be rendered (see the error above)";
+    return false;
+  }
+  if (view.Fractions.size() > 4)
+  {
+    this->LastErrorMessage = "more than 4 segments with fractional labelmaps";
     return false;
   }
   const int cuts = static_cast<int>(view.CutFields.size());
@@ -428,6 +435,17 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     }
     impl.Labels = view.Labels ? Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, labels.data())
                               : Internals::Texture3D(window, 2, 2, 2, 1, labels.data());
+    // Up to four segments' fractions, one per channel.
+    std::vector<float> fractions(view.Fractions.empty() ? 32 : 4 * voxels, 0.f);
+    for (size_t i = 0; i < view.Fractions.size(); ++i)
+    {
+      for (size_t n = 0; n < voxels; ++n)
+      {
+        fractions[4 * n + i] = view.Fractions[i].second[n];
+      }
+    }
+    impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
+                                            : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
     std::vector<float> styles(8 * view.Styles.size());
     const int styleCount = static_cast<int>(view.Styles.size());
     for (int label = 0; label < styleCount; ++label)
@@ -455,7 +473,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
       }
     }
     impl.Transfer = Internals::Texture2D(window, std::max(view.TableSize, 2), 1, 4, transfer.data());
-    if (!impl.Labels || !impl.Styles || !impl.Blocks || !impl.Transfer)
+    if (!impl.Labels || !impl.Fractions || !impl.Styles || !impl.Blocks || !impl.Transfer)
     {
       this->LastErrorMessage = "the label map or lookup tables do not fit in GPU memory";
       impl.Anatomy = nullptr;
@@ -541,7 +559,15 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniform3f("blockDimensionsF", blockDimensions);
   const float size[2] = { float(width), float(height) };
   program->SetUniform2f("viewportSize", size);
-  program->SetUniformi("hasLabels", view.Labels ? 1 : 0);
+  program->SetUniformi("hasLabels", view.Labels || !view.Fractions.empty() ? 1 : 0);
+  program->SetUniformi("hasLabelMap", view.Labels ? 1 : 0);
+  program->SetUniformi("fractionCount", static_cast<int>(view.Fractions.size()));
+  float fractionLabels[4] = { 0.f, 0.f, 0.f, 0.f };
+  for (size_t i = 0; i < view.Fractions.size(); ++i)
+  {
+    fractionLabels[i] = static_cast<float>(view.Fractions[i].first);
+  }
+  program->SetUniform4f("fractionLabels", fractionLabels);
   program->SetUniformi("styleCount", static_cast<int>(view.Styles.size()));
   program->SetUniformf("sampleDistance", static_cast<float>(s->GetSampleDistance()));
   program->SetUniformf("gradientStep", static_cast<float>(s->GetGradientStep()));
@@ -579,6 +605,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   };
   bindTexture(impl.Anatomy, "anatomyTexture");
   bindTexture(impl.Labels, "labelTexture");
+  bindTexture(impl.Fractions, "fractionTexture");
   bindTexture(impl.Styles, "styleTexture");
   bindTexture(impl.Blocks, "blockTexture");
   bindTexture(impl.OpaqueDepth, "opaqueDepthTexture");

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <vector>
 
 vtkStandardNewMacro(vtkVolumeCutRayCaster);
@@ -41,6 +42,7 @@ constexpr int ObjectBisections = 22;
 constexpr int CutBisections = 22;
 constexpr int TransferTableSize = 4096;
 constexpr int MaximumRefinements = 4;
+constexpr int MaximumFractions = 16;
 constexpr float OpaqueAlpha = 0.995f;
 
 struct SegmentStyle
@@ -124,6 +126,24 @@ struct vtkVolumeCutRayCaster::Internals
   std::vector<SegmentStyle> Styles;
   bool DefaultStyles = true;
 
+  // Fractional labelmaps: per segment, the fraction (0..1) of each voxel.
+  struct FractionInput
+  {
+    vtkSmartPointer<vtkImageData> Image;
+    double ValueAtZero = 0.0;
+    double ValueAtOne = 1.0;
+  };
+  std::map<int, FractionInput> FractionInputs;
+  struct FractionVolume
+  {
+    int Label = 0;
+    std::vector<float> Values;
+  };
+  std::vector<FractionVolume> Fractions;
+  vtkMTimeType FractionCopyTime = 0;
+
+  bool HasSegments() const { return !this->Labels.empty() || !this->Fractions.empty(); }
+
   std::vector<CutEntry> Cuts;
   vtkSmartPointer<vtkPlaneCollection> Planes;
   vtkSmartPointer<vtkColorTransferFunction> ColorFunction;
@@ -185,7 +205,9 @@ struct vtkVolumeCutRayCaster::Internals
     }
   }
 
-  float Interpolate(const double p[3]) const
+  float Interpolate(const double p[3]) const { return this->InterpolateArray(this->Values.data(), p); }
+
+  float InterpolateArray(const float* values, const double p[3]) const
   {
     int base[3];
     double f[3];
@@ -193,7 +215,7 @@ struct vtkVolumeCutRayCaster::Internals
     const vtkIdType sx = 1;
     const vtkIdType sy = this->Dimensions[0];
     const vtkIdType sz = static_cast<vtkIdType>(this->Dimensions[0]) * this->Dimensions[1];
-    const float* v = this->Values.data() + base[0] + base[1] * sy + base[2] * sz;
+    const float* v = values + base[0] + base[1] * sy + base[2] * sz;
     const double c00 = v[0] + f[0] * (v[sx] - v[0]);
     const double c10 = v[sy] + f[0] * (v[sy + sx] - v[sy]);
     const double c01 = v[sz] + f[0] * (v[sz + sx] - v[sz]);
@@ -213,10 +235,10 @@ struct vtkVolumeCutRayCaster::Internals
     int base[3];
     double f[3];
     this->CellOf(p, base, f);
-    int labels[8];
-    double weights[8];
+    int labels[8 + MaximumFractions];
+    double weights[8 + MaximumFractions];
     int count = 0;
-    for (int corner = 0; corner < 8; ++corner)
+    for (int corner = 0; corner < 8 && !this->Labels.empty(); ++corner)
     {
       const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
       const int label =
@@ -239,12 +261,28 @@ struct vtkVolumeCutRayCaster::Internals
       }
       weights[slot] += w;
     }
+    // A segment with a fractional labelmap weighs its interpolated fraction
+    // (the label map's indicator is its binary special case).
+    for (const FractionVolume& fraction : this->Fractions)
+    {
+      const double w = this->InterpolateArray(fraction.Values.data(), p);
+      int slot = 0;
+      while (slot < count && labels[slot] != fraction.Label)
+      {
+        ++slot;
+      }
+      if (slot == count)
+      {
+        labels[count++] = fraction.Label;
+      }
+      weights[slot] = w;
+    }
     int best = 0;
     weight = 0.0;
     for (int slot = 0; slot < count; ++slot)
     {
       // Ties go to the lower label so that every path decides the same way.
-      if (weights[slot] > weight || (weights[slot] == weight && labels[slot] < best))
+      if (weights[slot] > weight || (weights[slot] == weight && weight > 0.0 && labels[slot] < best))
       {
         best = labels[slot];
         weight = weights[slot];
@@ -256,6 +294,17 @@ struct vtkVolumeCutRayCaster::Internals
   // Interpolated indicator of one label (for shape-defined segments' normals).
   double Indicator(int label, const double p[3]) const
   {
+    for (const FractionVolume& fraction : this->Fractions)
+    {
+      if (fraction.Label == label)
+      {
+        return this->InterpolateArray(fraction.Values.data(), p);
+      }
+    }
+    if (this->Labels.empty())
+    {
+      return 0.0;
+    }
     int base[3];
     double f[3];
     this->CellOf(p, base, f);
@@ -276,7 +325,7 @@ struct vtkVolumeCutRayCaster::Internals
   int ObjectAt(const double p[3], float& value) const
   {
     value = this->Interpolate(p);
-    if (this->Labels.empty())
+    if (!this->HasSegments())
     {
       const SegmentStyle& style = this->Styles[1];
       return (style.Opacity > 0.f && value >= style.Iso) ? 1 : 0;
@@ -344,7 +393,7 @@ struct vtkVolumeCutRayCaster::Internals
       double minus[3] = { p[0], p[1], p[2] };
       plus[axis] += h;
       minus[axis] -= h;
-      if (!this->Labels.empty() && this->Styles[object].Shape)
+      if (this->HasSegments() && this->Styles[object].Shape)
       {
         gradient[axis] = this->Indicator(object, plus) - this->Indicator(object, minus);
       }
@@ -999,6 +1048,41 @@ void vtkVolumeCutRayCaster::SetLabelMap(vtkImageData* labels)
 }
 
 //------------------------------------------------------------------------------
+void vtkVolumeCutRayCaster::SetSegmentFraction(int label, vtkImageData* fraction, double valueAtZero, double valueAtOne)
+{
+  if (label < 1 || label > 65535 || !(std::abs(valueAtOne - valueAtZero) > 0.0) || !std::isfinite(valueAtZero) ||
+    !std::isfinite(valueAtOne))
+  {
+    vtkErrorMacro("SetSegmentFraction: needs a label in 1..65535 and two different finite values for fractions 0 and 1");
+    return;
+  }
+  if (!fraction)
+  {
+    if (this->Impl->FractionInputs.erase(label) == 0)
+    {
+      return; // nothing to remove: the image stays valid for localized updates
+    }
+  }
+  else if (this->Impl->FractionInputs.size() >= MaximumFractions && !this->Impl->FractionInputs.count(label))
+  {
+    vtkErrorMacro("SetSegmentFraction: at most " << MaximumFractions << " segments can have fractional labelmaps");
+    return;
+  }
+  else
+  {
+    this->Impl->FractionInputs[label] = { fraction, valueAtZero, valueAtOne };
+  }
+  this->Impl->FractionCopyTime = 0;
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutRayCaster::GetNumberOfSegmentFractions() const
+{
+  return static_cast<int>(this->Impl->FractionInputs.size());
+}
+
+//------------------------------------------------------------------------------
 void vtkVolumeCutRayCaster::SetSegmentAppearance(int label, const double color[3], double opacity, double isoValue)
 {
   if (label < 1 || label > 65535 || !color)
@@ -1284,6 +1368,43 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     sceneChanged = true;
   }
 
+  // Fractional labelmaps, copied to floats 0..1 when any of them changed.
+  vtkMTimeType fractionTime = 0;
+  for (const auto& entry : impl.FractionInputs)
+  {
+    vtkImageData* image = entry.second.Image;
+    fractionTime = std::max({ fractionTime, image->GetMTime(),
+      image->GetPointData()->GetScalars() ? image->GetPointData()->GetScalars()->GetMTime() : vtkMTimeType(0) });
+  }
+  if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.Fractions.size() || sceneChanged)
+  {
+    impl.Fractions.clear();
+    for (const auto& entry : impl.FractionInputs)
+    {
+      vtkImageData* image = entry.second.Image;
+      vtkDataArray* values = image->GetPointData()->GetScalars();
+      if (!values || !SameGeometry(image, anatomy))
+      {
+        vtkErrorMacro("Render: the fractional labelmap of segment " << entry.first << " must have the anatomy's dimensions; it is not shown");
+        continue;
+      }
+      Internals::FractionVolume fraction;
+      fraction.Label = entry.first;
+      fraction.Values.resize(values->GetNumberOfTuples());
+      const double v0 = entry.second.ValueAtZero;
+      const double scale = 1.0 / (entry.second.ValueAtOne - entry.second.ValueAtZero);
+      for (vtkIdType n = 0; n < values->GetNumberOfTuples(); ++n)
+      {
+        const double f = (values->GetComponent(n, 0) - v0) * scale;
+        fraction.Values[n] = std::isfinite(f) ? static_cast<float>(std::min(1.0, std::max(0.0, f))) : 0.f;
+      }
+      impl.Fractions.push_back(std::move(fraction));
+    }
+    impl.FractionCopyTime = std::max(fractionTime, vtkMTimeType(1));
+    impl.BlockTime = 0;
+    sceneChanged = true;
+  }
+
   // Segment 1 follows IsoValue until appearances are given.
   if (impl.DefaultStyles)
   {
@@ -1325,7 +1446,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   for (size_t label = 1; label < impl.Styles.size(); ++label)
   {
     const SegmentStyle& style = impl.Styles[label];
-    if (style.Opacity > 0.f && !style.Shape && (label == 1 || !impl.Labels.empty()))
+    if (style.Opacity > 0.f && !style.Shape && (label == 1 || impl.HasSegments()))
     {
       impl.AnyIsoSegment = true;
       impl.MinimumIso = std::min(impl.MinimumIso, double(style.Iso));
@@ -1427,11 +1548,35 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
                 }
               }
             }
-            else if (!composite)
+            if (!composite && !occupied)
+            {
+              // Fractional segments: any voxel of the block partly inside a shown one.
+              for (const Internals::FractionVolume& fraction : impl.Fractions)
+              {
+                const SegmentStyle& style =
+                  fraction.Label < static_cast<int>(impl.Styles.size()) ? impl.Styles[fraction.Label] : impl.Styles[0];
+                if (occupied || style.Opacity <= 0.f || (!style.Shape && hi < style.Iso))
+                {
+                  continue;
+                }
+                for (int k = int(bz) * BlockSize; k <= std::min((int(bz) + 1) * BlockSize, dims[2] - 1) && !occupied; ++k)
+                {
+                  for (int j = by * BlockSize; j <= std::min((by + 1) * BlockSize, dims[1] - 1) && !occupied; ++j)
+                  {
+                    const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
+                    for (int i = bx * BlockSize; i <= std::min((bx + 1) * BlockSize, dims[0] - 1) && !occupied; ++i)
+                    {
+                      occupied = fraction.Values[row + i] > 0.f;
+                    }
+                  }
+                }
+              }
+            }
+            if (!composite && !impl.HasSegments())
             {
               occupied = impl.Styles[1].Opacity > 0.f && hi >= impl.Styles[1].Iso;
             }
-            else
+            else if (composite)
             {
               // Any opacity over the block's value range.
               const double span = impl.TableRange[1] - impl.TableRange[0];
@@ -1573,6 +1718,11 @@ bool vtkVolumeCutRayCaster::UpdateScene(SceneView& view)
   std::copy(impl.WorldToIJK, impl.WorldToIJK + 16, view.WorldToIJK);
   std::copy(impl.NormalMatrix4Storage, impl.NormalMatrix4Storage + 16, view.NormalMatrix);
   view.Labels = impl.Labels.empty() ? nullptr : impl.Labels.data();
+  view.Fractions.clear();
+  for (const Internals::FractionVolume& fraction : impl.Fractions)
+  {
+    view.Fractions.emplace_back(fraction.Label, fraction.Values.data());
+  }
   view.Styles.clear();
   for (const SegmentStyle& style : impl.Styles)
   {

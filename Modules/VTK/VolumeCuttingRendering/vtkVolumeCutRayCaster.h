@@ -40,6 +40,7 @@
 
 #include <array>  // For SceneView
 #include <memory> // For std::unique_ptr
+#include <utility> // For SceneView
 #include <vector> // For SceneView
 
 class vtkColorTransferFunction;
@@ -80,10 +81,25 @@ public:
 
   /**
    * Optional label map on the anatomy's grid (integer labels 0..65535, 0 for
-   * no segment). Without it, every voxel belongs to segment 1. A voxel grid
+   * no segment). Without it (and without fractional labelmaps), every voxel
+   * belongs to segment 1. A voxel grid
    * that differs from the anatomy's is refused with an error.
    */
   void SetLabelMap(vtkImageData* labels);
+
+  ///@{
+  /**
+   * A fractional labelmap for the segment with the given label: an image on
+   * the anatomy's grid whose first component maps linearly from valueAtZero
+   * (voxel outside) to valueAtOne (voxel inside), e.g. 0..1 for floats or
+   * -108..108 for Slicer's fractional labelmaps. Where the segment has one,
+   * its interpolated fraction replaces the label map's binary indicator, so
+   * its surface (shape mode) and its borders with other segments are placed
+   * at sub-voxel accuracy. nullptr removes it; at most 16 segments.
+   */
+  void SetSegmentFraction(int label, vtkImageData* fraction, double valueAtZero = 0.0, double valueAtOne = 1.0);
+  int GetNumberOfSegmentFractions() const;
+  ///@}
 
   ///@{
   /**
@@ -229,6 +245,8 @@ public:
     double WorldToIJK[16];
     double NormalMatrix[16];
     const unsigned short* Labels = nullptr;
+    /// Fractional labelmaps: (label, fractions 0..1 on the anatomy's grid).
+    std::vector<std::pair<int, const float*>> Fractions;
     /// Per label: r, g, b, opacity, iso-value, shape flag, 0, 0.
     std::vector<std::array<float, 8>> Styles;
     int BlockDimensions[3] = { 0, 0, 0 };

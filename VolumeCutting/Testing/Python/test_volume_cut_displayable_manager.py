@@ -113,3 +113,53 @@ def test_rendering_settings_are_saved_with_the_node():
     assert copy.GetSurfaceIsoValue() == pytest.approx(412.5)
     assert copy.GetThinBoneShading()
     assert copy.GetThinBoneThickness() == pytest.approx(1.75)
+
+
+def test_fractional_labelmap_segments_are_drawn_at_sub_voxel_accuracy(session):
+    """A segment whose source representation is a fractional labelmap (Slicer's char -108..108)."""
+    application, scene, volume, cut_node, view = session
+    n = scene.dimensions
+    center = scene.center + np.array([0.13, -0.21, 0.07])  # mm
+    radius = 3.1  # mm
+    supersampling = 4
+    offsets = ((np.arange(supersampling) + 0.5) / supersampling - 0.5) * scene.spacing
+    axis = np.arange(n) * scene.spacing
+    fraction = np.zeros((n, n, n))
+    for dz in offsets:
+        for dy in offsets:
+            for dx in offsets:
+                fraction += (((axis + dx - center[0])[None, None, :] ** 2 + (axis + dy - center[1])[None, :, None] ** 2
+                              + (axis + dz - center[2])[:, None, None] ** 2) <= radius**2)
+    fraction /= supersampling**3
+    chars = np.round(fraction * 216.0 - 108.0).astype(np.int8)
+    oriented = slicer.vtkOrientedImageData()
+    oriented.SetDimensions(n, n, n)
+    oriented.GetPointData().SetScalars(numpy_support.numpy_to_vtk(chars.ravel(), deep=True, array_type=vtk.VTK_CHAR))
+    oriented.SetImageToWorldMatrix(scene.ijk_to_ras())
+    scalar_range = vtk.vtkDoubleArray()
+    scalar_range.SetName(slicer.vtkSegmentationConverter.GetScalarRangeFieldName())
+    scalar_range.InsertNextValue(-108.0)
+    scalar_range.InsertNextValue(108.0)
+    oriented.GetFieldData().AddArray(scalar_range)
+    segmentation_node = application.scene.AddNewNodeByClass("vtkMRMLSegmentationNode")
+    segmentation_node.CreateDefaultDisplayNodes()
+    segmentation = segmentation_node.GetSegmentation()
+    name = slicer.vtkSegmentationConverter.GetSegmentationFractionalLabelmapRepresentationName()
+    segmentation.SetSourceRepresentationName(name)
+    segment = slicer.vtkSegment()
+    segment.SetName("Ball")
+    segment.AddRepresentation(name, oriented)
+    segmentation.AddSegment(segment, "Ball")
+    cut_node.SetAndObserveSegmentationNodeID(segmentation_node.GetID())
+    # The CT cube is not a segment here: only the ball shows, by its own shape.
+    view.render()
+    _, depth = surface_z(view, 32, 32)
+    assert depth < 1.0
+    renderer = view.renderer
+    renderer.SetDisplayPoint(32.5, 32.5, 0.0)
+    renderer.DisplayToWorld()
+    near = renderer.GetWorldPoint()
+    off_axis = math.hypot(near[0] / near[3] - center[0], near[1] / near[3] - center[1])
+    z, _ = surface_z(view, 32, 32)
+    exact = center[2] + math.sqrt(radius**2 - off_axis**2)
+    assert z == pytest.approx(exact, abs=0.1 * scene.spacing)

@@ -18,7 +18,11 @@ uniform sampler3D blockTexture;     // per 8^3 block: (occupied, gradient bound)
 uniform sampler2D opaqueDepthTexture;
 uniform sampler2D transferTexture;  // composite mode: (rgb, opacity per unit distance)
 
-uniform int hasLabels;
+uniform int hasLabels;             // a label map or fractional labelmaps
+uniform int hasLabelMap;
+uniform sampler3D fractionTexture;  // up to 4 segments' fractions (RGBA)
+uniform int fractionCount;
+uniform vec4 fractionLabels;
 uniform int styleCount;
 uniform vec3 dimensionsF;
 uniform vec3 blockDimensionsF;
@@ -103,6 +107,21 @@ float intensity(vec3 p)
   return c0 + f.z * (c1 - c0);
 }
 
+vec4 fractionsAt(vec3 p)
+{
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  vec4 value = vec4(0.0);
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    ivec3 c = b + ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+    float w = ((corner & 1) != 0 ? f.x : 1.0 - f.x) * ((corner & 2) != 0 ? f.y : 1.0 - f.y) * ((corner & 4) != 0 ? f.z : 1.0 - f.z);
+    value += w * texelFetch(fractionTexture, c, 0);
+  }
+  return value;
+}
+
 vec4 styleColor(int label) { return texelFetch(styleTexture, ivec2(label, 0), 0); }
 vec4 styleSurface(int label) { return texelFetch(styleTexture, ivec2(label, 1), 0); }
 
@@ -118,10 +137,10 @@ int dominantLabel(vec3 p, out float weight)
   ivec3 b;
   vec3 f;
   cellOf(p, b, f);
-  int labels[8];
-  float weights[8];
+  int labels[12];
+  float weights[12];
   int count = 0;
-  for (int corner = 0; corner < 8; ++corner)
+  for (int corner = 0; corner < 8 && hasLabelMap != 0; ++corner)
   {
     int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
     if (label == 0)
@@ -142,11 +161,30 @@ int dominantLabel(vec3 p, out float weight)
     }
     weights[slot] += w;
   }
+  if (fractionCount > 0)
+  {
+    vec4 fractions = fractionsAt(p);
+    for (int i = 0; i < fractionCount; ++i)
+    {
+      int label = int(fractionLabels[i] + 0.5);
+      int slot = 0;
+      while (slot < count && labels[slot] != label)
+      {
+        ++slot;
+      }
+      if (slot == count)
+      {
+        labels[count] = label;
+        ++count;
+      }
+      weights[slot] = fractions[i];
+    }
+  }
   int best = 0;
   weight = 0.0;
   for (int slot = 0; slot < count; ++slot)
   {
-    if (weights[slot] > weight || (weights[slot] == weight && labels[slot] < best))
+    if (weights[slot] > weight || (weights[slot] == weight && weight > 0.0 && labels[slot] < best))
     {
       best = labels[slot];
       weight = weights[slot];
@@ -157,6 +195,17 @@ int dominantLabel(vec3 p, out float weight)
 
 float indicator(int label, vec3 p)
 {
+  for (int i = 0; i < fractionCount; ++i)
+  {
+    if (int(fractionLabels[i] + 0.5) == label)
+    {
+      return fractionsAt(p)[i];
+    }
+  }
+  if (hasLabelMap == 0)
+  {
+    return 0.0;
+  }
   ivec3 b;
   vec3 f;
   cellOf(p, b, f);

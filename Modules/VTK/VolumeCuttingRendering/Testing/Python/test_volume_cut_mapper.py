@@ -456,3 +456,92 @@ def test_stereo_draws_each_eye_with_its_own_camera(scene, intensities, path):
     for eye in (left, right):
         assert (np.abs(eye - background).sum(axis=2) > 30).mean() > 0.2
     assert np.abs(left - right).sum(axis=2).astype(bool).mean() > 0.01  # parallax
+
+
+def sphere_segment(n, center, radius, supersampling=4):
+    """Fractional (partial-volume) and binary labelmaps of a ball on a unit grid."""
+    offsets = (np.arange(supersampling) + 0.5) / supersampling - 0.5
+    index = np.arange(n, dtype=float)
+    fraction = np.zeros((n, n, n))
+    for dz in offsets:
+        for dy in offsets:
+            for dx in offsets:
+                z = (index + dz - center[2])[:, None, None]
+                y = (index + dy - center[1])[None, :, None]
+                x = (index + dx - center[0])[None, None, :]
+                fraction += (x * x + y * y + z * z) <= radius * radius
+    fraction /= supersampling**3
+    binary = np.zeros((n, n, n), np.uint16)
+    z, y, x = np.meshgrid(index - center[2], index - center[1], index - center[0], indexing="ij")
+    binary[(x * x + y * y + z * z) <= radius * radius] = 1
+
+    def image(values, vtk_type):
+        result = vtk.vtkImageData()
+        result.SetDimensions(n, n, n)
+        result.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.ravel(), deep=True, array_type=vtk_type))
+        return result
+
+    return image(fraction.astype(np.float32), vtk.VTK_FLOAT), image(binary, vtk.VTK_UNSIGNED_SHORT)
+
+
+def test_fractional_labelmaps_place_segment_surfaces_at_sub_voxel_accuracy():
+    n, center, radius = 32, (15.3, 15.6, 15.2), 9.0
+    fraction, binary = sphere_segment(n, center, radius)
+    ct = vtk.vtkImageData()
+    ct.SetDimensions(n, n, n)
+    ct.AllocateScalars(vtk.VTK_FLOAT, 1)
+    ct.GetPointData().GetScalars().Fill(0.0)
+    camera = vtk.vtkCamera()
+    camera.ParallelProjectionOn()
+    camera.SetParallelScale(11.0)
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(center[0], center[1], center[2] + 50.0)
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(20.0, 80.0)
+    width = 64
+    matrix = A.world_to_ndc(camera, width, width)
+    errors = {}
+    for kind in ("fraction", "binary"):
+        caster = vc.vtkVolumeCutRayCaster()
+        caster.SetAnatomy(ct, None)
+        if kind == "fraction":
+            caster.SetSegmentFraction(3, fraction, 0.0, 1.0)
+        else:
+            caster.SetLabelMap(binary)
+        caster.SetSegmentAppearance(3 if kind == "fraction" else 1, (0.9, 0.8, 0.2), 1.0, float("nan"))
+        assert caster.Render(matrix, width, width)
+        depth = image_array(caster.GetDepthImage, width, width, 1)
+        points = A.depth_to_points(matrix, depth.astype(float))
+        r_xy = np.hypot(points[..., 0] - center[0], points[..., 1] - center[1])
+        inner = (depth < 1.0) & (r_xy < 0.8 * radius)
+        exact = center[2] + np.sqrt(radius**2 - r_xy[inner] ** 2)
+        errors[kind] = float(np.sqrt(np.mean((points[..., 2][inner] - exact) ** 2)))
+    assert errors["fraction"] < 0.1  # voxels
+    assert errors["fraction"] < 0.5 * errors["binary"]
+
+
+@pytest.mark.parametrize("with_label_map", [False, True])
+def test_gpu_path_draws_fractional_segments_like_the_cpu(scene, intensities, with_label_map):
+    width = 48
+    n = scene.dimensions
+    fraction, binary = sphere_segment(n, tuple(scene.center / scene.spacing + [0.3, -0.2, 0.1]), 9.0)
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 1.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    caster = mapper.GetRayCaster()
+    if with_label_map:
+        caster.SetLabelMap(binary)  # label 1 everywhere the ball is; the fraction overrides it
+    caster.SetSegmentFraction(1, fraction)
+    caster.SetSegmentAppearance(1, (0.2, 0.6, 0.9), 1.0, float("nan"))
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    assert np.any(cpu_depth < 1.0)
+    assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
