@@ -545,3 +545,21 @@ def test_gpu_path_draws_fractional_segments_like_the_cpu(scene, intensities, wit
     assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
     assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
     assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+
+
+@pytest.mark.parametrize("path", ["CPUPath", "GPUPath"])
+def test_a_lost_context_is_rebuilt_without_a_crash(scene, intensities, path):
+    """The window's context goes away (Finalize releases every GPU resource) and comes back."""
+    width = 32
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 2.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    mapper.SetRequestedRenderPath(getattr(vc.vtkVolumeCutVolumeMapper, path))
+    window.Render()
+    before, _ = read_window(window, width)
+    window.Finalize()
+    window.Render()
+    after, _ = read_window(window, width)
+    assert mapper.GetLastRenderPath() == getattr(vc.vtkVolumeCutVolumeMapper, path)
+    assert np.any(before < 1.0)
+    assert np.allclose(before, after, atol=1e-6)
