@@ -11,6 +11,13 @@
 // VolumeCutting Logic includes
 #include <vtkSlicerVolumeCuttingLogic.h>
 
+// DisplayableManager initialization
+#include <vtkAutoInit.h>
+VTK_MODULE_INIT(vtkSlicerVolumeCuttingModuleMRMLDisplayableManager)
+
+// MRMLDisplayableManager includes
+#include <vtkMRMLThreeDViewDisplayableManagerFactory.h>
+
 // VolumeCutting includes
 #include "qSlicerVolumeCuttingModule.h"
 #include "qSlicerVolumeCuttingModuleWidget.h"
@@ -80,6 +87,8 @@ QStringList qSlicerVolumeCuttingModule::associatedNodeTypes() const
 void qSlicerVolumeCuttingModule::setup()
 {
   this->Superclass::setup();
+  // 3D views show volume-cut nodes through the adaptive multivolume mapper.
+  vtkMRMLThreeDViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutDisplayableManager");
 }
 
 //-----------------------------------------------------------------------------
