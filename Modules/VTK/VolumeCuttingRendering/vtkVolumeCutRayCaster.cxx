@@ -238,17 +238,25 @@ struct vtkVolumeCutRayCaster::Internals
     int labels[8 + MaximumFractions];
     double weights[8 + MaximumFractions];
     int count = 0;
+    double unlabelledBright = 0.0;
     for (int corner = 0; corner < 8 && !this->Labels.empty(); ++corner)
     {
       const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
-      const int label =
-        this->Labels[c[0] + static_cast<vtkIdType>(this->Dimensions[0]) * (c[1] + static_cast<vtkIdType>(this->Dimensions[1]) * c[2])];
-      if (label == 0)
-      {
-        continue;
-      }
+      const vtkIdType voxel = c[0] + static_cast<vtkIdType>(this->Dimensions[0]) * (c[1] + static_cast<vtkIdType>(this->Dimensions[1]) * c[2]);
+      const int label = this->Labels[voxel];
       const double w =
         ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
+      if (label == 0)
+      {
+        // Material above the surface value that no shown segment claims
+        // competes like a segment: its border with a shown one is smooth,
+        // not the cell faces where a labelled voxel first counts.
+        if (this->AnyIsoSegment && this->Values[voxel] >= this->MinimumIso)
+        {
+          unlabelledBright += w;
+        }
+        continue;
+      }
       int slot = 0;
       while (slot < count && labels[slot] != label)
       {
@@ -287,6 +295,10 @@ struct vtkVolumeCutRayCaster::Internals
         best = labels[slot];
         weight = weights[slot];
       }
+    }
+    if (unlabelledBright > weight)
+    {
+      return 0;
     }
     return best;
   }

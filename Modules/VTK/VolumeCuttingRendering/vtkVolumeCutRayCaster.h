@@ -276,10 +276,10 @@ protected:
   double ScalarOpacityUnitDistance = 1.0;
   bool ThinBoneShading = false;
   double ThinBoneThickness = 1.0;
-  double Ambient = 0.25;
+  double Ambient = 0.15;
   double Diffuse = 0.7;
-  double Specular = 0.2;
-  double SpecularPower = 20.0;
+  double Specular = 0.15;
+  double SpecularPower = 30.0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;
   int UpdatedRegion[4] = { 0, 0, -1, -1 };

@@ -154,6 +154,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
     removed.GetDisplayNode().SetVisibility3D(False)
     removed_fraction = logic.ExportRemovedFractionToVolume(cut_node, None)
     removed_model = logic.ExportRemovedSurfaceToModel(cut_node, None)
+    # The view shows the cavity itself, not the model of what filled it.
+    removed_model.GetDisplayNode().SetVisibility(False)
     storage = removed_model.CreateDefaultStorageNode()
     storage.SetFileName(str(out_dir / "removed.stl"))
     if not storage.WriteData(removed_model):
@@ -178,7 +180,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
     volume.GetRASBounds(bounds)
     lateral = 1.0 if entry[0] > (bounds[0] + bounds[1]) / 2.0 else -1.0
     rim = entry + np.array([0.0, 0.0, 0.85 * plan.surface_radius])
-    view.look_at(rim, direction=(lateral * 0.8, 0.0, 0.6), distance=18.0, view_up=(0.0, 0.0, 1.0))
+    # From outside the head, a little above, so the rim's edge shows against the cavity.
+    view.look_at(rim, direction=(lateral * 0.94, 0.0, 0.34), distance=45.0, view_up=(0.0, 0.0, 1.0))
+    view.renderer.GetActiveCamera().SetViewAngle(12.0)
+    view.renderer.ResetCameraClippingRange()
     cut_node.SetThinBoneShading(False)  # the edge itself, in the bone's colour
     view.render()
     cut_node.SetThinBoneShading(True)

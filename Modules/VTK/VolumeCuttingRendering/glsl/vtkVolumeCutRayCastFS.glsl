@@ -140,14 +140,19 @@ int dominantLabel(vec3 p, out float weight)
   int labels[12];
   float weights[12];
   int count = 0;
+  float unlabelledBright = 0.0;
   for (int corner = 0; corner < 8 && hasLabelMap != 0; ++corner)
   {
     int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
+    float w = cornerWeight(corner, f);
     if (label == 0)
     {
+      if (anyIso != 0 && texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r >= minimumIso)
+      {
+        unlabelledBright += w;
+      }
       continue;
     }
-    float w = cornerWeight(corner, f);
     int slot = 0;
     while (slot < count && labels[slot] != label)
     {
@@ -189,6 +194,10 @@ int dominantLabel(vec3 p, out float weight)
       best = labels[slot];
       weight = weights[slot];
     }
+  }
+  if (unlabelledBright > weight)
+  {
+    return 0;
   }
   return best;
 }
