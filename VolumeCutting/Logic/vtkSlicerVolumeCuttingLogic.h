@@ -92,6 +92,10 @@ public:
   /// p1 (RAS, mm); BeginStroke/EndStroke group poses into one undo step.
   /// Return false, with the reason in the log, when the stroke is refused
   /// (bad pose or radius, no anatomy); what was cut before is kept.
+  /// Each accepted cut, restore, undo or redo invokes the node's
+  /// CutModifiedEvent, so call these from the thread that owns the scene; a
+  /// haptic thread cuts the vtkVolumeCutField itself (no events) and views
+  /// find the changed bricks by their stamps.
   bool BeginStroke(vtkMRMLVolumeCutNode* cutNode);
   bool CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);
   bool RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);

@@ -65,8 +65,8 @@ float cutDistance@N@(vec3 world)
   vec3 second = vec3(0.0);
   for (int corner = 0; corner < 8; ++corner)
   {
-    ivec3 c = i0 + ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-    float w = ((corner & 1) != 0 ? f.x : 1.0 - f.x) * ((corner & 2) != 0 ? f.y : 1.0 - f.y) * ((corner & 4) != 0 ? f.z : 1.0 - f.z);
+    ivec3 c = i0 + cornerOffset(corner);
+    float w = cornerWeight(corner, f);
     if (w == 0.0)
     {
       continue;
@@ -166,6 +166,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkSmartPointer<vtkTextureObject> OpaqueDepth;
   CutTextures Cuts[MaximumNumberOfCutFields];
   vtkMTimeType AnatomyVersion = 0;
+  vtkMTimeType LabelVersion = 0;
   vtkMTimeType SceneVersion = 0;
   int ShaderCuts = -1;
   std::unique_ptr<vtkOpenGLQuadHelper> Quad;
@@ -196,6 +197,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       this->Quad.reset();
     }
     this->AnatomyVersion = 0;
+    this->LabelVersion = 0;
     this->SceneVersion = 0;
     this->ShaderCuts = -1;
     this->Context = nullptr;
@@ -414,20 +416,22 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     return false;
   }
 
-  // Anatomy and labels: when the CT or its grid changed.
-  if (!impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion || impl.SceneVersion != view.Version)
+  // Each texture travels when what it holds changed: the CT with its values
+  // or grid, labels and fractions with them, the small tables with anything.
+  const size_t voxels = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
+  const bool anatomyChanged = !impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion;
+  if (anatomyChanged)
   {
-    if (!impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion)
+    impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, view.Values);
+    if (!impl.Anatomy)
     {
-      impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, view.Values);
-      if (!impl.Anatomy)
-      {
-        this->LastErrorMessage = "the CT does not fit in GPU memory as a float 3D texture";
-        return false;
-      }
-      impl.AnatomyVersion = view.AnatomyVersion;
+      this->LastErrorMessage = "the CT does not fit in GPU memory as a float 3D texture";
+      return false;
     }
-    const size_t voxels = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
+    impl.AnatomyVersion = view.AnatomyVersion;
+  }
+  if (anatomyChanged || !impl.Labels || !impl.Fractions || impl.LabelVersion != view.LabelVersion)
+  {
     std::vector<float> labels(view.Labels ? voxels : 8, 0.f);
     if (view.Labels)
     {
@@ -446,6 +450,17 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     }
     impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
                                             : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
+    if (!impl.Labels || !impl.Fractions)
+    {
+      this->LastErrorMessage = "the label map or fractional labelmaps do not fit in GPU memory";
+      impl.Labels = impl.Fractions = nullptr;
+      return false;
+    }
+    impl.LabelVersion = view.LabelVersion;
+    impl.SceneVersion = 0; // the tables follow
+  }
+  if (impl.SceneVersion != view.Version)
+  {
     std::vector<float> styles(8 * view.Styles.size());
     const int styleCount = static_cast<int>(view.Styles.size());
     for (int label = 0; label < styleCount; ++label)
@@ -473,10 +488,9 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
       }
     }
     impl.Transfer = Internals::Texture2D(window, std::max(view.TableSize, 2), 1, 4, transfer.data());
-    if (!impl.Labels || !impl.Fractions || !impl.Styles || !impl.Blocks || !impl.Transfer)
+    if (!impl.Styles || !impl.Blocks || !impl.Transfer)
     {
-      this->LastErrorMessage = "the label map or lookup tables do not fit in GPU memory";
-      impl.Anatomy = nullptr;
+      this->LastErrorMessage = "the lookup tables do not fit in GPU memory";
       return false;
     }
     impl.SceneVersion = view.Version;

@@ -154,14 +154,13 @@ struct vtkVolumeCutRayCaster::Internals
 
   // Empty-space skipping: blocks of BlockSize^3 cells that may hold a visible object.
   int BlockDimensions[3] = { 0, 0, 0 };
-  std::vector<float> BlockMinimum;
-  std::vector<float> BlockMaximum;
   std::vector<uint8_t> BlockOccupied;
   std::vector<float> BlockLipschitz; // bound of the CT's gradient (per voxel) in the block
   bool AnyIsoSegment = false;
   double MinimumIso = 0.0;
   vtkMTimeType BlockTime = 0;
   vtkMTimeType SceneVersion = 1;
+  vtkMTimeType LabelVersion = 1; // changes when the label map or fractions are copied or dropped
 
   // Last image, for localized updates.
   int Width = 0;
@@ -586,12 +585,12 @@ struct vtkVolumeCutRayCaster::Internals
     }
   }
 
-  double MeasureThickness(int object, const double index[3], const double normalWorld[3]) const;
+  double MeasureThickness(const double index[3], const double normalWorld[3]) const;
   void CastRay(int x, int y, const double* opaqueLimit);
 };
 
 //------------------------------------------------------------------------------
-double vtkVolumeCutRayCaster::Internals::MeasureThickness(int vtkNotUsed(object), const double index[3], const double normalWorld[3]) const
+double vtkVolumeCutRayCaster::Internals::MeasureThickness(const double index[3], const double normalWorld[3]) const
 {
   // March inward (against the outward normal) until the visible material
   // ends, in steps of a quarter voxel, up to the threshold.
@@ -799,7 +798,7 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
     float alpha = style.Opacity;
     if (this->ThinBone)
     {
-      const double thickness = this->MeasureThickness(piece.Object, index, normal);
+      const double thickness = this->MeasureThickness(index, normal);
       if (thickness < this->ThinBoneThickness)
       {
         const float f = static_cast<float>(thickness / this->ThinBoneThickness);
@@ -819,6 +818,28 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
   // time, and the first visible piece between them. Where a border could
   // hide between the samples (a grazing ray through a thin sliver of an
   // object or of a cut), the interval is halved first.
+  // Every border of every volume between two samples, in ray order: the
+  // object's (iso-surface mode) and each cut field's.
+  auto findBorders = [&](const Sample& a, const Sample& b, bool withObject, Border* borders) -> int {
+    int count = 0;
+    if (withObject && a.Object != b.Object)
+    {
+      borders[count++] = { this->BisectObject(o, d, a, b), SourceObject };
+    }
+    if (a.CutsKnown && b.CutsKnown)
+    {
+      for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
+      {
+        if ((a.Distance[n] < 0.0) != (b.Distance[n] < 0.0))
+        {
+          borders[count++] = { this->BisectCut(static_cast<int>(n), o, d, a, b), SourceCutField + static_cast<int>(n) };
+        }
+      }
+    }
+    std::sort(borders, borders + count, [](const Border& l, const Border& r) { return l.T < r.T; });
+    return count;
+  };
+
   bool insideVisible = false;
   auto surfaceInterval = [&](auto& self, Sample& a, Sample& b, int depth) -> bool {
     if (a.Object != 0 || b.Object != 0)
@@ -848,22 +869,7 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
       return false;
     }
     Border borders[MaximumCutFields + 1];
-    int count = 0;
-    if (a.Object != b.Object)
-    {
-      borders[count++] = { this->BisectObject(o, d, a, b), SourceObject };
-    }
-    if (a.CutsKnown && b.CutsKnown)
-    {
-      for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-      {
-        if ((a.Distance[n] < 0.0) != (b.Distance[n] < 0.0))
-        {
-          borders[count++] = { this->BisectCut(static_cast<int>(n), o, d, a, b), SourceCutField + static_cast<int>(n) };
-        }
-      }
-    }
-    std::sort(borders, borders + count, [](const Border& l, const Border& r) { return l.T < r.T; });
+    const int count = findBorders(a, b, true, borders);
     for (int border = 0; border < count; ++border)
     {
       const double end = border + 1 < count ? borders[border + 1].T : b.T;
@@ -938,81 +944,70 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
     this->EvaluateCuts(b);
 
     // Every cut's border between a and b.
-    Border borders[MaximumCutFields];
-    int count = 0;
-    for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-    {
-      if ((a.Distance[n] < 0.0) != (b.Distance[n] < 0.0))
-      {
-        borders[count++] = { this->BisectCut(static_cast<int>(n), o, d, a, b), SourceCutField + static_cast<int>(n) };
-      }
-    }
-    std::sort(borders, borders + count, [](const Border& l, const Border& r) { return l.T < r.T; });
+    Border borders[MaximumCutFields + 1];
+    const int count = findBorders(a, b, false, borders);
 
-    if (composite)
+    // Front-to-back compositing of the pieces outside every cut.
+    double start = a.T;
+    for (int piece = 0; piece <= count; ++piece)
     {
-      // Front-to-back compositing of the pieces outside every cut.
-      double start = a.T;
-      for (int piece = 0; piece <= count; ++piece)
+      const double end = piece < count ? borders[piece].T : b.T;
+      if (end > start)
       {
-        const double end = piece < count ? borders[piece].T : b.T;
-        if (end > start)
+        Sample mid = this->At(o, d, 0.5 * (start + end));
+        this->EvaluateObject(mid);
+        this->EvaluateCuts(mid);
+        if (!this->Removed(mid))
         {
-          Sample mid = this->At(o, d, 0.5 * (start + end));
-          this->EvaluateObject(mid);
-          this->EvaluateCuts(mid);
-          if (!this->Removed(mid))
+          float rgb[3];
+          float opacity;
+          this->LookUp(mid.Value, rgb, opacity);
+          if (opacity > 0.f)
           {
-            float rgb[3];
-            float opacity;
-            this->LookUp(mid.Value, rgb, opacity);
-            if (opacity > 0.f)
+            const float alpha = 1.f - std::pow(1.f - std::min(opacity, 0.9999f), static_cast<float>((end - start) / this->UnitDistance));
+            double normal[3];
+            int source = SourceObject;
+            if (lastCutBorder >= 0)
             {
-              const float alpha = 1.f - std::pow(1.f - std::min(opacity, 0.9999f), static_cast<float>((end - start) / this->UnitDistance));
-              double normal[3];
-              int source = SourceObject;
-              if (lastCutBorder >= 0)
-              {
-                // The first piece after a cut border shows the cut surface.
-                double world[3];
-                this->WorldPoint(mid.Index, world);
-                this->CutNormal(lastCutBorder, world, normal);
-                source = SourceCutField + lastCutBorder;
-              }
-              else
-              {
-                // Composite mode shades with the CT's gradient whatever the labels.
-                double gradient[3];
-                for (int axis = 0; axis < 3; ++axis)
-                {
-                  double plus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
-                  double minus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
-                  plus[axis] += this->GradientStep;
-                  minus[axis] -= this->GradientStep;
-                  gradient[axis] = double(this->Interpolate(minus)) - double(this->Interpolate(plus));
-                }
-                TransformVector(this->NormalMatrix4(), gradient, normal);
-                vtkMath::Normalize(normal);
-              }
-              float shaded[3];
-              this->Shade(rgb, normal, view, shaded);
-              // Depth and normal belong to the first piece that clearly shows.
-              // (a cut surface is a surface: its first piece always counts).
-              record(start, source, normal, shaded, alpha, lastCutBorder >= 0 ? 0.f : 0.02f);
-              if (color[3] >= OpaqueAlpha)
-              {
-                return;
-              }
+              // The first piece after a cut border shows the cut surface.
+              double world[3];
+              this->WorldPoint(mid.Index, world);
+              this->CutNormal(lastCutBorder, world, normal);
+              source = SourceCutField + lastCutBorder;
             }
-            lastCutBorder = -1;
+            else
+            {
+              // Composite mode shades with the CT's gradient whatever the labels.
+              double gradient[3];
+              for (int axis = 0; axis < 3; ++axis)
+              {
+                double plus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
+                double minus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
+                plus[axis] += this->GradientStep;
+                minus[axis] -= this->GradientStep;
+                gradient[axis] = double(this->Interpolate(minus)) - double(this->Interpolate(plus));
+              }
+              TransformVector(this->NormalMatrix4(), gradient, normal);
+              vtkMath::Normalize(normal);
+            }
+            float shaded[3];
+            this->Shade(rgb, normal, view, shaded);
+            // Depth and normal belong to the first piece that clearly shows.
+            // (a cut surface is a surface: its first piece always counts).
+            record(start, source, normal, shaded, alpha, lastCutBorder >= 0 ? 0.f : 0.02f);
+            if (color[3] >= OpaqueAlpha)
+            {
+              return;
+            }
           }
+          lastCutBorder = -1;
         }
-        if (piece < count)
-        {
-          lastCutBorder = borders[piece].Source >= SourceCutField ? borders[piece].Source - SourceCutField : -1;
-        }
-        start = end;
       }
+      if (piece < count)
+      {
+        lastCutBorder = borders[piece].Source >= SourceCutField ? borders[piece].Source - SourceCutField : -1;
+      }
+      start = end;
     }
     a = b;
   }
@@ -1346,6 +1341,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     if (!impl.Labels.empty())
     {
       impl.Labels.clear();
+      ++impl.LabelVersion;
       sceneChanged = true;
       impl.BlockTime = 0;
     }
@@ -1376,6 +1372,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       }
     }
     impl.LabelCopyTime = std::max(labelMap->GetMTime(), labelScalars ? labelScalars->GetMTime() : 0);
+    ++impl.LabelVersion;
     impl.BlockTime = 0;
     sceneChanged = true;
   }
@@ -1413,6 +1410,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       impl.Fractions.push_back(std::move(fraction));
     }
     impl.FractionCopyTime = std::max(fractionTime, vtkMTimeType(1));
+    ++impl.LabelVersion;
     impl.BlockTime = 0;
     sceneChanged = true;
   }
@@ -1491,8 +1489,6 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       impl.BlockDimensions[axis] = (dims[axis] - 1 + BlockSize - 1) / BlockSize;
     }
     const vtkIdType blockCount = static_cast<vtkIdType>(impl.BlockDimensions[0]) * impl.BlockDimensions[1] * impl.BlockDimensions[2];
-    impl.BlockMinimum.assign(blockCount, std::numeric_limits<float>::infinity());
-    impl.BlockMaximum.assign(blockCount, -std::numeric_limits<float>::infinity());
     impl.BlockOccupied.assign(blockCount, 0);
     impl.BlockLipschitz.assign(blockCount, 0.f);
     const bool composite = this->BlendMode == CompositeBlend;
@@ -1603,8 +1599,6 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
                 occupied = impl.OpacityTable[n] > 0.f;
               }
             }
-            impl.BlockMinimum[block] = lo;
-            impl.BlockMaximum[block] = hi;
             impl.BlockOccupied[block] = occupied ? 1 : 0;
             // NaN voxels make the bound infinite: such blocks are always refined.
             const float lipschitz = std::sqrt(slope[0] * slope[0] + slope[1] * slope[1] + slope[2] * slope[2]);
@@ -1724,6 +1718,7 @@ bool vtkVolumeCutRayCaster::UpdateScene(SceneView& view)
   const Internals& impl = *this->Impl;
   view.Version = impl.SceneVersion;
   view.AnatomyVersion = impl.AnatomyCopyTime;
+  view.LabelVersion = impl.LabelVersion;
   view.Values = impl.Values.data();
   std::copy(impl.Dimensions, impl.Dimensions + 3, view.Dimensions);
   std::copy(impl.IJKToWorld, impl.IJKToWorld + 16, view.IJKToWorld);
@@ -1818,6 +1813,10 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   if (localized)
   {
     mask.assign(pixels, 0);
+    this->UpdatedRegion[0] = width;
+    this->UpdatedRegion[1] = height;
+    this->UpdatedRegion[2] = -1;
+    this->UpdatedRegion[3] = -1;
     vtkNew<vtkIdList> bricks;
     for (int index : impl.ActiveCuts)
     {
@@ -1871,6 +1870,13 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
         {
           std::fill(mask.begin() + static_cast<vtkIdType>(y) * width + x0, mask.begin() + static_cast<vtkIdType>(y) * width + x1 + 1, 1);
         }
+        if (x0 <= x1 && y0 <= y1)
+        {
+          this->UpdatedRegion[0] = std::min(this->UpdatedRegion[0], x0);
+          this->UpdatedRegion[1] = std::min(this->UpdatedRegion[1], y0);
+          this->UpdatedRegion[2] = std::max(this->UpdatedRegion[2], x1);
+          this->UpdatedRegion[3] = std::max(this->UpdatedRegion[3], y1);
+        }
       }
     }
   }
@@ -1912,28 +1918,13 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     });
   }
 
-  // The rectangle of pixels this call changes.
-  this->UpdatedRegion[0] = 0;
-  this->UpdatedRegion[1] = 0;
-  this->UpdatedRegion[2] = width - 1;
-  this->UpdatedRegion[3] = height - 1;
-  if (localized)
+  // The rectangle of pixels this call changes (the union of the bricks' rectangles).
+  if (!localized)
   {
-    int region[4] = { width, height, -1, -1 };
-    for (int y = 0; y < height; ++y)
-    {
-      for (int x = 0; x < width; ++x)
-      {
-        if (mask[static_cast<vtkIdType>(y) * width + x])
-        {
-          region[0] = std::min(region[0], x);
-          region[1] = std::min(region[1], y);
-          region[2] = std::max(region[2], x);
-          region[3] = std::max(region[3], y);
-        }
-      }
-    }
-    std::copy(region, region + 4, this->UpdatedRegion);
+    this->UpdatedRegion[0] = 0;
+    this->UpdatedRegion[1] = 0;
+    this->UpdatedRegion[2] = width - 1;
+    this->UpdatedRegion[3] = height - 1;
   }
 
   std::atomic<vtkIdType> cast(0);

@@ -239,6 +239,7 @@ public:
   {
     vtkMTimeType Version = 0;
     vtkMTimeType AnatomyVersion = 0; // changes when the CT values or grid change
+    vtkMTimeType LabelVersion = 0;   // changes when the label map or fractions change
     const float* Values = nullptr;
     int Dimensions[3] = { 0, 0, 0 };
     double IJKToWorld[16];

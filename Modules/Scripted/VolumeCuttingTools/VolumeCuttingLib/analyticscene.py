@@ -391,7 +391,7 @@ def _nearest_distance(queries: np.ndarray, points: np.ndarray) -> np.ndarray:
     return result
 
 
-def _near_borders(classes: np.ndarray, margin: int) -> np.ndarray:
+def near_borders(classes: np.ndarray, margin: int) -> np.ndarray:
     """Pixels within ``margin`` pixels (Chebyshev) of a class border."""
     border = np.zeros(classes.shape, bool)
     border[:, 1:] |= classes[:, 1:] != classes[:, :-1]
@@ -419,7 +419,7 @@ def normal_errors(reference: Reference, normals: np.ndarray, classes: np.ndarray
     """Angles (degrees) between normals and the exact ones, away from borders."""
     inside_image = np.zeros(classes.shape, bool)
     inside_image[margin:-margin, margin:-margin] = True
-    sel = (classes == reference.classes) & (reference.classes != BACKGROUND) & ~_near_borders(reference.classes, margin) & inside_image
+    sel = (classes == reference.classes) & (reference.classes != BACKGROUND) & ~near_borders(reference.classes, margin) & inside_image
     a = normals[sel]
     b = reference.normals[sel]
     ok = np.all(np.isfinite(a), axis=1)

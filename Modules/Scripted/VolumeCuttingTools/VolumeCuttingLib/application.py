@@ -24,6 +24,15 @@ THREE_D_DISPLAYABLE_MANAGERS = (
 )
 
 
+def opengl_renderer_name(render_window) -> str:
+    """The OpenGL renderer of a window that has rendered (llvmpipe, or a GPU's name)."""
+    capabilities = render_window.ReportCapabilities() or ""
+    for line in capabilities.splitlines():
+        if "OpenGL renderer string" in line:
+            return line.split(":", 1)[1].strip()
+    return "unknown"
+
+
 class HeadlessSlicer:
     """A scene with the application and module logics that VolumeCutting relies on.
 
@@ -128,11 +137,7 @@ class ThreeDView:
     def renderer_description(self) -> str:
         """The OpenGL renderer in use (for example llvmpipe, or a GPU's name)."""
         self.render()
-        capabilities = self.render_window.ReportCapabilities() or ""
-        for line in capabilities.splitlines():
-            if "OpenGL renderer string" in line:
-                return line.split(":", 1)[1].strip()
-        return "unknown"
+        return opengl_renderer_name(self.render_window)
 
     def screenshot(self, path: str | Path) -> Path:
         path = Path(path)

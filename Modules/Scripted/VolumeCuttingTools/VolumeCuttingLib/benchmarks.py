@@ -434,7 +434,7 @@ def cutfield(repeats: int) -> list[dict]:
 def mapper(repeats: int) -> list[dict]:
     from . import mapperbenchmarks
 
-    return mapperbenchmarks.mapper(repeats, machine_description)
+    return mapperbenchmarks.mapper(repeats)
 
 
 AREAS = {

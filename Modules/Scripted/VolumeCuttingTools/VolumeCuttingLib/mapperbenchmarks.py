@@ -22,14 +22,8 @@ import vtk
 from vtkmodules.util import numpy_support
 
 from . import analyticscene as A
-
-
-def _renderer_name(window) -> str:
-    info = window.ReportCapabilities() or ""
-    for line in info.splitlines():
-        if "OpenGL renderer string" in line:
-            return line.split(":", 1)[1].strip()
-    return "unknown"
+from .application import opengl_renderer_name
+from .benchmarks import machine_description, measurement, timed
 
 
 def _stock_volume(scene, masked):
@@ -86,16 +80,16 @@ def _finish(window):
 
 
 def _frame_time(window, repeats):
-    window.Render()  # uploads and compiles outside the timing
+    """Median time of a whole frame, uploads and shader compilation left out."""
+    window.Render()
     _finish(window)
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
+
+    def frame():
         window.Modified()
         window.Render()
         _finish(window)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
+
+    return timed(frame, repeats)[0]
 
 
 def _accuracy(scene, matrix, width, depth, own_normals=None):
@@ -106,7 +100,7 @@ def _accuracy(scene, matrix, width, depth, own_normals=None):
     result = {
         "edge": A.summarize(A.edge_errors(reference, classes)),
         "normal_from_depth": A.summarize(A.normal_errors(reference, A.normals_from_points(points, reference.view_directions), classes)),
-        "edge_pixels_checked": int(np.sum(A._near_borders(reference.classes, 0))),
+        "edge_pixels_checked": int(np.sum(A.near_borders(reference.classes, 0))),
     }
     if own_normals is not None:
         result["normal_shading"] = A.summarize(A.normal_errors(reference, own_normals.astype(float), classes))
@@ -114,22 +108,14 @@ def _accuracy(scene, matrix, width, depth, own_normals=None):
 
 
 def _entry(name, value, unit, baseline_name, baseline_value, machine, repeats=1, details=None):
-    entry = {
-        "name": name,
-        "value": round(float(value), 6),
-        "unit": unit,
-        "baseline_name": baseline_name,
-        "baseline_value": round(float(baseline_value), 6),
-        "ratio": round(float(value) / float(baseline_value), 4) if baseline_value else None,
-        "repeats": repeats,
-        "machine": machine,
-    }
+    """A benchmark measurement (benchmarks.measurement), with optional details."""
+    entry = measurement(name, float(value), unit, baseline_name, float(baseline_value), repeats, machine)
     if details is not None:
         entry["details"] = details
     return entry
 
 
-def mapper(repeats: int, machine_description) -> list[dict]:
+def mapper(repeats: int) -> list[dict]:
     results = []
     width = 512
     scene = A.default_scene()
@@ -160,7 +146,7 @@ def mapper(repeats: int, machine_description) -> list[dict]:
     stock_volume = _stock_volume(scene, masked)
     renderer.AddVolume(stock_volume)
     window.Render()
-    renderer_name = _renderer_name(window)
+    renderer_name = opengl_renderer_name(window)
     machine = machine_description(renderer_name)
     stock_image = vtk.vtkImageData()
     stock_volume.GetMapper().GetDepthImage(stock_image)
@@ -204,7 +190,7 @@ def mapper(repeats: int, machine_description) -> list[dict]:
         "color_max_abs_difference": float(np.max(np.abs(cpu_color - gpu_color))),
         "pixels_color_difference_over_2_of_255": float(np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2.0 / 255.0)),
     }
-    results.append(_entry("OpenGL vs CPU: fraction of pixels whose colour differs by more than 2/255", 
+    results.append(_entry("OpenGL vs CPU: fraction of pixels whose colour differs by more than 2/255",
                           agreement["pixels_color_difference_over_2_of_255"], "fraction", "tolerance", 0.005, machine,
                           details=agreement))
 

@@ -107,21 +107,6 @@ float intensity(vec3 p)
   return c0 + f.z * (c1 - c0);
 }
 
-vec4 fractionsAt(vec3 p)
-{
-  ivec3 b;
-  vec3 f;
-  cellOf(p, b, f);
-  vec4 value = vec4(0.0);
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    ivec3 c = b + ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-    float w = ((corner & 1) != 0 ? f.x : 1.0 - f.x) * ((corner & 2) != 0 ? f.y : 1.0 - f.y) * ((corner & 4) != 0 ? f.z : 1.0 - f.z);
-    value += w * texelFetch(fractionTexture, c, 0);
-  }
-  return value;
-}
-
 vec4 styleColor(int label) { return texelFetch(styleTexture, ivec2(label, 0), 0); }
 vec4 styleSurface(int label) { return texelFetch(styleTexture, ivec2(label, 1), 0); }
 
@@ -131,6 +116,19 @@ float cornerWeight(int corner, vec3 f)
 }
 
 ivec3 cornerOffset(int corner) { return ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1); }
+
+vec4 fractionsAt(vec3 p)
+{
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  vec4 value = vec4(0.0);
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    value += cornerWeight(corner, f) * texelFetch(fractionTexture, b + cornerOffset(corner), 0);
+  }
+  return value;
+}
 
 int dominantLabel(vec3 p, out float weight)
 {
@@ -521,6 +519,23 @@ bool enter(Sample piece, float t, int source)
 
 bool insideVisible = false;
 
+// Insertion sort of at most NUMBER_OF_CUTS + 1 borders by ray parameter.
+void sortBorders(inout float borderT[CUT_SLOTS + 1], inout int borderSource[CUT_SLOTS + 1], int count)
+{
+  for (int i = 1; i < count; ++i)
+  {
+    for (int j = i; j > 0 && borderT[j - 1] > borderT[j]; --j)
+    {
+      float t = borderT[j];
+      borderT[j] = borderT[j - 1];
+      borderT[j - 1] = t;
+      int source = borderSource[j];
+      borderSource[j] = borderSource[j - 1];
+      borderSource[j - 1] = source;
+    }
+  }
+}
+
 // The borders between two samples and the first visible piece between them.
 bool leafInterval(inout Sample a, inout Sample b)
 {
@@ -545,19 +560,7 @@ bool leafInterval(inout Sample a, inout Sample b)
       }
     }
   }
-  // Insertion sort (at most NUMBER_OF_CUTS + 1 borders).
-  for (int i = 1; i < count; ++i)
-  {
-    for (int j = i; j > 0 && borderT[j - 1] > borderT[j]; --j)
-    {
-      float t = borderT[j];
-      borderT[j] = borderT[j - 1];
-      borderT[j - 1] = t;
-      int s = borderSource[j];
-      borderSource[j] = borderSource[j - 1];
-      borderSource[j - 1] = s;
-    }
-  }
+  sortBorders(borderT, borderSource, count);
   for (int border = 0; border < count; ++border)
   {
     float endT = border + 1 < count ? borderT[border + 1] : b.t;
@@ -749,8 +752,8 @@ void main()
     }
     evaluateCuts(a);
     evaluateCuts(b);
-    float borderT[CUT_SLOTS];
-    int borderCut[CUT_SLOTS];
+    float borderT[CUT_SLOTS + 1];
+    int borderCut[CUT_SLOTS + 1];
     int count = 0;
     for (int n = 0; n < NUMBER_OF_CUTS; ++n)
     {
@@ -761,18 +764,7 @@ void main()
         ++count;
       }
     }
-    for (int i = 1; i < count; ++i)
-    {
-      for (int j = i; j > 0 && borderT[j - 1] > borderT[j]; --j)
-      {
-        float t = borderT[j];
-        borderT[j] = borderT[j - 1];
-        borderT[j - 1] = t;
-        int s = borderCut[j];
-        borderCut[j] = borderCut[j - 1];
-        borderCut[j - 1] = s;
-      }
-    }
+    sortBorders(borderT, borderCut, count);
     float startT = a.t;
     for (int piece = 0; piece <= count && !done; ++piece)
     {

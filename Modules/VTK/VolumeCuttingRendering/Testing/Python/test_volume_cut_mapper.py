@@ -104,10 +104,10 @@ def test_whole_voxel_masking_misses_the_edges_the_field_places(scene, intensitie
     assert A.edge_errors(reference, classes).max(initial=0.0) > 1.0
 
 
-def render_window(width):
+def render_window(width, height=None):
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
-    window.SetSize(width, width)
+    window.SetSize(width, height or width)
     renderer = vtk.vtkRenderer()
     window.AddRenderer(renderer)
     return window, renderer
@@ -433,14 +433,10 @@ def test_gpu_path_falls_back_to_the_cpu_with_a_reason():
 def test_stereo_draws_each_eye_with_its_own_camera(scene, intensities, path):
     """Split-viewport stereo: both eyes show the cut cube, from slightly different places."""
     width = 64
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(2 * width, width)
+    window, renderer = render_window(2 * width, width)
     window.SetStereoCapableWindow(1)
     window.SetStereoTypeToSplitViewportHorizontal()
     window.StereoRenderOn()
-    renderer = vtk.vtkRenderer()
-    window.AddRenderer(renderer)
     camera = A.make_camera(scene, 2.0, width, width)
     camera.SetEyeAngle(6.0)
     renderer.SetActiveCamera(camera)
