@@ -105,6 +105,33 @@ void TransformVector(const double m[16], const double in[3], double out[3])
     out[row] = m[4 * row] * in[0] + m[4 * row + 1] * in[1] + m[4 * row + 2] * in[2];
   }
 }
+
+/// vtkSMPTools::For over [0, end) with at most maximumThreads threads (0: all
+/// cores). The VTK wheels start on the Sequential backend, which would leave a
+/// CPU reference that is meant to be multithreaded on one core: there the
+/// standard-thread backend is used for these loops only. Slicer's own build
+/// runs TBB and keeps it.
+template <typename Work>
+void ParallelFor(int maximumThreads, vtkIdType end, Work&& work)
+{
+  if (maximumThreads == 1)
+  {
+    work(vtkIdType(0), end);
+    return;
+  }
+  const bool sequentialDefault = std::strcmp(vtkSMPTools::GetBackend(), "Sequential") == 0;
+  vtkSMPTools::Config config;
+  if (sequentialDefault)
+  {
+    config.Backend = "STDThread";
+  }
+  else
+  {
+    config.Backend = vtkSMPTools::GetBackend();
+  }
+  config.MaxNumberOfThreads = maximumThreads;
+  vtkSMPTools::LocalScope(config, [&] { vtkSMPTools::For(0, end, work); });
+}
 }
 
 //------------------------------------------------------------------------------
@@ -1492,7 +1519,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     impl.BlockOccupied.assign(blockCount, 0);
     impl.BlockLipschitz.assign(blockCount, 0.f);
     const bool composite = this->BlendMode == CompositeBlend;
-    vtkSMPTools::For(0, impl.BlockDimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+    ParallelFor(this->MaximumNumberOfThreads, impl.BlockDimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
       for (vtkIdType bz = beginZ; bz < endZ; ++bz)
       {
         for (int by = 0; by < impl.BlockDimensions[1]; ++by)
@@ -1892,7 +1919,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   {
     // Ray length to the opaque geometry in each pixel.
     limits.resize(pixels);
-    vtkSMPTools::For(0, height, [&](vtkIdType begin, vtkIdType end) {
+    ParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
       for (vtkIdType y = begin; y < end; ++y)
       {
         for (int x = 0; x < width; ++x)
@@ -1928,7 +1955,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   }
 
   std::atomic<vtkIdType> cast(0);
-  vtkSMPTools::For(0, height, [&](vtkIdType begin, vtkIdType end) {
+  ParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
     vtkIdType local = 0;
     for (vtkIdType y = begin; y < end; ++y)
     {
@@ -1963,6 +1990,7 @@ void vtkVolumeCutRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ThinBoneShading: " << this->ThinBoneShading << " (" << this->ThinBoneThickness << " mm)\n";
   os << indent << "Lighting: ambient " << this->Ambient << ", diffuse " << this->Diffuse << ", specular " << this->Specular << "^"
      << this->SpecularPower << "\n";
+  os << indent << "MaximumNumberOfThreads: " << this->MaximumNumberOfThreads << "\n";
   os << indent << "Anatomy: " << this->Impl->Anatomy.GetPointer() << "\n";
   os << indent << "LabelMap: " << this->Impl->LabelMap.GetPointer() << "\n";
   os << indent << "SegmentAppearances: " << this->GetNumberOfSegmentAppearances() << "\n";

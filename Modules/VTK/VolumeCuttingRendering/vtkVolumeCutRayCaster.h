@@ -174,6 +174,15 @@ public:
   vtkGetMacro(SpecularPower, double);
   ///@}
 
+  ///@{
+  /**
+   * At most this many threads cast rays (0, the default: one per core; 1:
+   * the calling thread only, as a ThreadSanitizer run of the caller needs).
+   */
+  vtkSetClampMacro(MaximumNumberOfThreads, int, 0, 4096);
+  vtkGetMacro(MaximumNumberOfThreads, int);
+  ///@}
+
   /**
    * Cast the rays of a width x height image seen through \a worldToNDC (the
    * camera's composite projection: world to normalized device coordinates,
@@ -281,6 +290,7 @@ protected:
   double Diffuse = 0.7;
   double Specular = 0.15;
   double SpecularPower = 30.0;
+  int MaximumNumberOfThreads = 0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;
   int UpdatedRegion[4] = { 0, 0, -1, -1 };
