@@ -329,6 +329,9 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
   this->BandWidth = 3.5 * std::max({ spacing[0], spacing[1], spacing[2] });
   this->Quantum = this->BandWidth / (Outside - 1);
   this->HalfDiagonal = 0.5 * std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
+  // Beyond the correction's largest size (0.75 of the largest spacing) and
+  // the normal's finite differences: 3 spacings, inside the band.
+  this->CorrectionReach = 3.0 * std::max({ spacing[0], spacing[1], spacing[2] });
   this->RowScratch.assign(static_cast<size_t>(BrickSize) * BrickSize * dimensions[0], Outside);
   this->DistanceScratch.assign(static_cast<size_t>(dimensions[0]), 0.0f);
   const vtkIdType totalBricks = static_cast<vtkIdType>(brickCount);
@@ -1318,23 +1321,34 @@ double vtkVolumeCutField::InterpolateAtIndex(const double index[3]) const
   const int j0 = static_cast<int>(std::floor(index[1]));
   const int k0 = static_cast<int>(std::floor(index[2]));
   const double f[3] = { index[0] - i0, index[1] - j0, index[2] - k0 };
+  double weights[8];
+  double centers[8];
   double value = 0.0;
-  double secondDifference[3] = { 0.0, 0.0, 0.0 };
   for (int corner = 0; corner < 8; ++corner)
   {
-    const int c[3] = { i0 + (corner & 1), j0 + ((corner >> 1) & 1), k0 + ((corner >> 2) & 1) };
-    const double weight =
+    weights[corner] =
       ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
-    if (weight == 0.0)
+    if (weights[corner] == 0.0)
     {
       continue;
     }
-    const double center = this->ReadSample(c[0], c[1], c[2]);
-    value += weight * center;
-    if (center == Outside || center == Inside)
+    centers[corner] = this->ReadSample(i0 + (corner & 1), j0 + ((corner >> 1) & 1), k0 + ((corner >> 2) & 1));
+    value += weights[corner] * centers[corner];
+  }
+  if (std::abs(value) * this->Quantum > this->CorrectionReach)
+  {
+    return value * this->Quantum;
+  }
+  double secondDifference[3] = { 0.0, 0.0, 0.0 };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    const double weight = weights[corner];
+    const double center = centers[corner];
+    if (weight == 0.0 || center == Outside || center == Inside)
     {
       continue; // clamped: no curvature information
     }
+    const int c[3] = { i0 + (corner & 1), j0 + ((corner >> 1) & 1), k0 + ((corner >> 2) & 1) };
     const double neighbors[3][2] = { { double(this->ReadSample(c[0] - 1, c[1], c[2])), double(this->ReadSample(c[0] + 1, c[1], c[2])) },
       { double(this->ReadSample(c[0], c[1] - 1, c[2])), double(this->ReadSample(c[0], c[1] + 1, c[2])) },
       { double(this->ReadSample(c[0], c[1], c[2] - 1)), double(this->ReadSample(c[0], c[1], c[2] + 1)) } };
@@ -1526,6 +1540,7 @@ void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Dimensions: " << this->Dimensions[0] << " " << this->Dimensions[1] << " " << this->Dimensions[2] << "\n";
   os << indent << "SubVoxelFactor: " << this->SubVoxelFactor << "\n";
   os << indent << "BandWidth: " << this->BandWidth << "\n";
+  os << indent << "CorrectionReach: " << this->CorrectionReach << "\n";
   os << indent << "MaximumStrokeLength: " << this->MaximumStrokeLength << "\n";
   os << indent << "NumberOfAllocatedBricks: " << this->GetNumberOfAllocatedBricks() << "\n";
   os << indent << "UndoSteps: " << this->UndoStack.size() << " (" << this->UndoMemorySize / 1024 << " KiB of " << this->UndoMemoryBudget / 1024

@@ -215,8 +215,16 @@ public:
    * point, trilinearly interpolated with a curvature correction from the
    * samples' second differences; negative where removed. Points outside
    * the band or the volume return +BandWidth. Safe to call while a writer cuts.
+   * Where the interpolated distance exceeds GetCorrectionReach() the
+   * correction (at most a quarter of the sum of the sub-voxel spacings) is
+   * left out: it cannot change the sign there, and the renderers, which
+   * evaluate distances at every ray sample inside the anatomy, then need 8
+   * samples instead of 56.
    */
   double GetSignedDistance(const double ras[3]) const;
+
+  /// Distance (mm) from the surface within which GetSignedDistance is corrected for curvature.
+  vtkGetMacro(CorrectionReach, double);
 
   /**
    * Removed fraction (0..1) of the sub-voxel (i, j, k): the partial-volume
@@ -319,6 +327,7 @@ protected:
   double BandWidth = 1.0;
   double Quantum = 1.0 / 32767.0;
   double HalfDiagonal = 0.5;
+  double CorrectionReach = 1.0;
   double MaximumStrokeLength = 50.0;
   double SubIJKToRAS[4][4];
   double AnatomyIJKToRAS[16];

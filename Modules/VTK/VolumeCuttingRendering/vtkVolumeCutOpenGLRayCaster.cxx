@@ -39,6 +39,7 @@ uniform int cutSlots@N@;
 uniform mat4 worldToSub@N@;
 uniform float cutQuantum@N@;
 uniform float cutStep@N@;
+uniform float cutCorrectionReach@N@; // in sample units
 ivec3 cutDimensions@N@;
 float cutSample@N@(ivec3 c)
 {
@@ -62,21 +63,34 @@ float cutDistance@N@(vec3 world)
   ivec3 i0 = ivec3(floor(index));
   vec3 f = index - vec3(i0);
   float value = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    float w = cornerWeight(corner, f);
+    if (w != 0.0)
+    {
+      value += w * cutSample@N@(i0 + cornerOffset(corner));
+    }
+  }
+  // As vtkVolumeCutField::GetSignedDistance: the curvature correction only
+  // near the surface, where it matters.
+  if (abs(value) > cutCorrectionReach@N@)
+  {
+    return value * cutQuantum@N@;
+  }
   vec3 second = vec3(0.0);
   for (int corner = 0; corner < 8; ++corner)
   {
-    ivec3 c = i0 + cornerOffset(corner);
     float w = cornerWeight(corner, f);
     if (w == 0.0)
     {
       continue;
     }
-    float center = cutSample@N@(c);
-    value += w * center;
+    float center = cutSample@N@(i0 + cornerOffset(corner));
     if (abs(center) == 32767.0)
     {
       continue;
     }
+    ivec3 c = i0 + cornerOffset(corner);
     for (int axis = 0; axis < 3; ++axis)
     {
       ivec3 e = ivec3(0);
@@ -640,6 +654,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     ColumnMajor(&worldToSub->Element[0][0], matrix);
     program->SetUniformMatrix4x4(("worldToSub" + index).c_str(), matrix);
     program->SetUniformf(("cutQuantum" + index).c_str(), static_cast<float>(view.CutFields[n]->GetQuantum()));
+    program->SetUniformf(("cutCorrectionReach" + index).c_str(),
+      static_cast<float>(view.CutFields[n]->GetCorrectionReach() / view.CutFields[n]->GetQuantum()));
     double spacing[3];
     view.CutFields[n]->GetSubVoxelSpacing(spacing);
     program->SetUniformf(("cutStep" + index).c_str(), static_cast<float>(0.25 * std::min({ spacing[0], spacing[1], spacing[2] })));
