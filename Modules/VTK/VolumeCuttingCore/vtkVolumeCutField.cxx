@@ -63,8 +63,11 @@ void Transform(const double m[4][4], const double in[3], double out[3])
 class CapsuleRowIntersector
 {
 public:
-  CapsuleRowIntersector(const double p0[3], const double p1[3], double radius, const double step[3])
+  /// Without the start ball, the sweep ahead of p0: behind it the caller
+  /// clips, and ahead of it the ball lies within the cylinder and the end ball.
+  CapsuleRowIntersector(const double p0[3], const double p1[3], double radius, const double step[3], bool withStartBall = true)
     : Radius2(radius * radius)
+    , WithStartBall(withStartBall)
   {
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -91,7 +94,10 @@ public:
   {
     first = std::numeric_limits<double>::max();
     last = -std::numeric_limits<double>::max();
-    this->Sphere(origin, this->P0, first, last);
+    if (this->WithStartBall)
+    {
+      this->Sphere(origin, this->P0, first, last);
+    }
     this->Sphere(origin, this->P1, first, last);
     if (this->Length > 0.0)
     {
@@ -178,6 +184,7 @@ private:
   double Axis[3];
   double Length = 0.0;
   double Radius2;
+  bool WithStartBall;
   double StepStep = 0.0;
   double StepAxis = 0.0;
   double CylinderA = 0.0;
@@ -358,12 +365,15 @@ void vtkVolumeCutField::Reset()
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
   this->ProtectionBricks.clear();
+  this->LastCapsule.Valid = false;
   this->ResetContact();
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::ResetContact()
 {
+  // The next capsule reports its whole reach again, the ball it starts in too.
+  this->LastCapsule.Valid = false;
   this->MaximumContactDepth = 0.0;
   this->ContactLabel = 0;
   std::fill(this->ContactPosition, this->ContactPosition + 3, 0.0);
@@ -379,6 +389,7 @@ const vtkVolumeCutField::ProtectionBrick* vtkVolumeCutField::GetProtectionBrick(
 bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
 {
   this->ProtectionBricks.clear();
+  this->LastCapsule.Valid = false; // what the last capsule could cut has changed
   if (!labels)
   {
     return true;
@@ -595,21 +606,23 @@ vtkVolumeCutField::Brick* vtkVolumeCutField::GetOrCreateBrick(vtkIdType brickId)
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick)
 {
-  if (this->StrokeBefore.count(brickId))
+  // A brick that did not exist is remembered empty, expanded at EndStroke:
+  // a moving burr enters new bricks every few segments, and the haptic
+  // thread should not fill kilobytes of Outside for each.
+  const auto inserted = this->StrokeBefore.try_emplace(brickId);
+  if (!inserted.second || !brick)
   {
     return;
   }
-  BrickValues values(SamplesPerBrick, Outside);
-  if (brick)
+  BrickValues& values = inserted.first->second;
+  values.resize(SamplesPerBrick);
+  for (int index = 0; index < SamplesPerBrick; ++index)
   {
-    for (int index = 0; index < SamplesPerBrick; ++index)
-    {
-      values[index] = brick->Values[index].load(std::memory_order_relaxed);
-    }
+    values[index] = brick->Values[index].load(std::memory_order_relaxed);
   }
-  this->StrokeBefore.emplace(brickId, std::move(values));
 }
 
+//------------------------------------------------------------------------------
 namespace
 {
 /// The sweep of a sphere: a capsule, with closed-form row intervals and a
@@ -617,10 +630,13 @@ namespace
 class CapsuleSource : public vtkVolumeCutField::DistanceSource
 {
 public:
-  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3])
+  /// startCovered: the ball at p0 was cut already (a continued path), so
+  /// only samples ahead of p0 along the segment can change.
+  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3], bool startCovered)
     : Radius(radius)
     , Reach(reach)
-    , Intersector(p0, p1, reach, rowStep)
+    , StartCovered(startCovered)
+    , Intersector(p0, p1, reach, rowStep, !startCovered)
   {
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -639,7 +655,33 @@ public:
       upper[axis] = std::max(this->P0[axis], this->P1[axis]) + this->Reach;
     }
   }
-  bool RowInterval(const double origin[3], double& first, double& last) const override { return this->Intersector.Intersect(origin, first, last); }
+  bool RowInterval(const double origin[3], double& first, double& last) const override
+  {
+    if (!this->Intersector.Intersect(origin, first, last))
+    {
+      return false;
+    }
+    if (this->StartCovered && this->AbLength2 > 0.0)
+    {
+      // Behind p0 ((x - p0) . ab <= 0) the capsule's distance is the ball's
+      // at p0, which the field holds already.
+      const double ahead = (origin[0] - this->P0[0]) * this->Ab[0] + (origin[1] - this->P0[1]) * this->Ab[1] + (origin[2] - this->P0[2]) * this->Ab[2];
+      const double rate = this->Step[0] * this->Ab[0] + this->Step[1] * this->Ab[1] + this->Step[2] * this->Ab[2];
+      if (rate > 0.0)
+      {
+        first = std::max(first, -ahead / rate);
+      }
+      else if (rate < 0.0)
+      {
+        last = std::min(last, -ahead / rate);
+      }
+      else if (ahead <= 0.0)
+      {
+        return false;
+      }
+    }
+    return first <= last;
+  }
   void RowDistances(const double origin[3], int first, int last, float* distances) const override
   {
     // Single precision: the quantum is 1e-5 of the band, far above float
@@ -676,6 +718,7 @@ private:
   double AbLength2 = 0.0;
   double Radius;
   double Reach;
+  bool StartCovered;
   CapsuleRowIntersector Intersector;
 };
 } // namespace
@@ -916,8 +959,15 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
     return false;
   }
   const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
-  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep);
+  const CapsuleContinuation& last = this->LastCapsule;
+  const bool continued = operation == Operation::Cut && last.Valid && last.Stamp == this->GetCurrentStamp() && last.Radius == radius &&
+    last.End[0] == p0[0] && last.End[1] == p0[1] && last.End[2] == p0[2];
+  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep, continued);
   this->ApplyDistance(source, operation);
+  this->LastCapsule.Valid = operation == Operation::Cut;
+  std::copy(p1, p1 + 3, this->LastCapsule.End);
+  this->LastCapsule.Radius = radius;
+  this->LastCapsule.Stamp = this->GetCurrentStamp();
   return true;
 }
 
@@ -1046,56 +1096,61 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
           const int count = iEnd - iBegin + 1;
           const int16_t* quantized = &this->RowScratch[static_cast<size_t>(r) * this->Dimensions[0] + iBegin];
           const int rowStart = row.LocalOffset + (iBegin - bi * BrickSize);
-          int16_t old[BrickSize];
-          for (int n = 0; n < count; ++n)
-          {
-            old[n] = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
-          }
           // Cut: min(field, tool distance). Restore: max(field, -tool distance).
           int16_t* merged = &changedValues[changes];
           int rowChanged = 0;
-          if (operation == Operation::Cut && protection)
+          if (operation == Operation::Cut && !protection)
           {
-            // The tool minus the protected voxels: max(tool, -protection).
+            // The common case, read straight from the brick (this thread is its only writer).
             for (int n = 0; n < count; ++n)
             {
-              const int16_t protectedDistance = protection->Distance[rowStart + n];
-              const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
-              if (quantized[n] < 0 && protectedDistance < 0)
-              {
-                // A protected sample inside the tool: how far inside (exact,
-                // not clamped to the band) is the depth of the contact.
-                const int local = rowStart + n;
-                const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
-                  double(bk * BrickSize + local / (BrickSize * BrickSize)) };
-                double point[3];
-                Transform(this->SubIJKToRAS, index, point);
-                const double depth = -source.Distance(point);
-                if (depth > this->MaximumContactDepth)
-                {
-                  this->MaximumContactDepth = depth;
-                  this->ContactLabel = protection->Label[local];
-                  std::copy(point, point + 3, this->ContactPosition);
-                }
-              }
-              merged[n] = effective < old[n] ? effective : old[n];
-              rowChanged |= merged[n] != old[n];
-            }
-          }
-          else if (operation == Operation::Cut)
-          {
-            for (int n = 0; n < count; ++n)
-            {
-              merged[n] = quantized[n] < old[n] ? quantized[n] : old[n];
-              rowChanged |= merged[n] != old[n];
+              const int16_t old = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
+              merged[n] = quantized[n] < old ? quantized[n] : old;
+              rowChanged |= merged[n] != old;
             }
           }
           else
           {
+            int16_t old[BrickSize];
             for (int n = 0; n < count; ++n)
             {
-              merged[n] = quantized[n] > old[n] ? quantized[n] : old[n];
-              rowChanged |= merged[n] != old[n];
+              old[n] = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
+            }
+            if (operation == Operation::Cut)
+            {
+              // The tool minus the protected voxels: max(tool, -protection).
+              for (int n = 0; n < count; ++n)
+              {
+                const int16_t protectedDistance = protection->Distance[rowStart + n];
+                const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
+                if (quantized[n] < 0 && protectedDistance < 0)
+                {
+                  // A protected sample inside the tool: how far inside (exact,
+                  // not clamped to the band) is the depth of the contact.
+                  const int local = rowStart + n;
+                  const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
+                    double(bk * BrickSize + local / (BrickSize * BrickSize)) };
+                  double point[3];
+                  Transform(this->SubIJKToRAS, index, point);
+                  const double depth = -source.Distance(point);
+                  if (depth > this->MaximumContactDepth)
+                  {
+                    this->MaximumContactDepth = depth;
+                    this->ContactLabel = protection->Label[local];
+                    std::copy(point, point + 3, this->ContactPosition);
+                  }
+                }
+                merged[n] = effective < old[n] ? effective : old[n];
+                rowChanged |= merged[n] != old[n];
+              }
+            }
+            else
+            {
+              for (int n = 0; n < count; ++n)
+              {
+                merged[n] = quantized[n] > old[n] ? quantized[n] : old[n];
+                rowChanged |= merged[n] != old[n];
+              }
             }
           }
           if (rowChanged)
@@ -1171,6 +1226,10 @@ void vtkVolumeCutField::EndStroke()
     for (int index = 0; brick && index < SamplesPerBrick; ++index)
     {
       after[index] = brick->Values[index].load(std::memory_order_relaxed);
+    }
+    if (entry.second.empty())
+    {
+      entry.second.assign(SamplesPerBrick, Outside); // the brick did not exist
     }
     step.Before.emplace_back(entry.first, std::move(entry.second));
     step.After.emplace_back(entry.first, std::move(after));

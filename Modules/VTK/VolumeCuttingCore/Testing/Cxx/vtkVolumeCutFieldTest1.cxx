@@ -180,6 +180,48 @@ int TestCapsuleAndStrokeEquivalence()
   return EXIT_SUCCESS;
 }
 
+// A capsule that starts where the last one ended skips the half ball behind
+// its start, which is already cut: only while nothing changed the field.
+int TestPathContinuationOnlyWhileUnchanged()
+{
+  const int dims[3] = { 64, 48, 48 };
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  MakeGrid(ijkToRas);
+  const double a[3] = { 6.0, 12.0, 12.0 };
+  const double m[3] = { 14.0, 12.0, 12.0 };
+  const double b[3] = { 22.0, 12.0, 12.0 };
+  const double behind[3] = { 13.0, 12.0, 12.0 }; // inside the ball at m, behind m
+  const double radius = 2.0;
+  vtkNew<vtkVolumeCutField> field;
+  field->Initialize(dims, ijkToRas, 2);
+  CHECK_BOOL(field->CutCapsule(a, m, radius), true);
+  CHECK_BOOL(field->RestoreCapsule(m, m, radius), true);
+  CHECK_BOOL(field->GetSignedDistance(behind) > 0.0, true);
+  // The restore changed the field: the next capsule must cut its whole ball.
+  CHECK_BOOL(field->CutCapsule(m, b, radius), true);
+  CHECK_BOOL(field->GetSignedDistance(behind) < 0.0, true);
+
+  // Undo between two segments likewise.
+  vtkNew<vtkVolumeCutField> undone;
+  undone->Initialize(dims, ijkToRas, 2);
+  undone->CutCapsule(a, m, radius);
+  undone->Undo();
+  CHECK_BOOL(undone->CutCapsule(m, b, radius), true);
+  CHECK_BOOL(undone->GetSignedDistance(behind) < 0.0, true);
+
+  // A continued path removes exactly what one capsule removes.
+  vtkNew<vtkVolumeCutField> continued;
+  continued->Initialize(dims, ijkToRas, 2);
+  continued->CutCapsule(a, m, radius);
+  continued->CutCapsule(m, b, radius);
+  vtkNew<vtkVolumeCutField> whole;
+  whole->Initialize(dims, ijkToRas, 2);
+  whole->CutCapsule(a, b, radius);
+  CHECK_BOOL(std::abs(continued->ComputeRemovedVolume() - whole->ComputeRemovedVolume()) / whole->ComputeRemovedVolume() <= 1e-4, true);
+  return EXIT_SUCCESS;
+}
+
+//------------------------------------------------------------------------------
 int TestRestoreUndoRedoAndStamps()
 {
   const int dims[3] = { 48, 48, 48 };
@@ -382,6 +424,7 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestSphereAccuracy(false));
   CHECK_EXIT_SUCCESS(TestSphereAccuracy(true));
   CHECK_EXIT_SUCCESS(TestCapsuleAndStrokeEquivalence());
+  CHECK_EXIT_SUCCESS(TestPathContinuationOnlyWhileUnchanged());
   CHECK_EXIT_SUCCESS(TestRestoreUndoRedoAndStamps());
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
