@@ -258,9 +258,10 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     const int* dims = field->GetDimensions();
     const bool sameField = cut.Field == field && cut.Page && cut.Dimensions[0] == dims[0] && cut.Dimensions[1] == dims[1] &&
       cut.Dimensions[2] == dims[2];
+    // The counter first: a brick stamped after it is listed next time.
+    const vtkTypeUInt64 stamp = field->GetCurrentStamp();
     vtkNew<vtkIdList> modified;
     field->GetBricksModifiedSince(sameField ? cut.Stamp : 0, modified);
-    const vtkTypeUInt64 stamp = field->GetCurrentStamp();
     if (sameField && modified->GetNumberOfIds() == 0)
     {
       cut.Stamp = stamp;

@@ -1837,6 +1837,13 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
 
   // Which pixels to cast: all, or those covering bricks changed since the last image.
   std::vector<uint8_t> mask;
+  // Read before the modified bricks are listed: a brick stamped after this
+  // is listed next time (the field publishes a brick's stamp before its counter).
+  std::vector<vtkTypeUInt64> currentStamps;
+  for (CutEntry& entry : impl.Cuts)
+  {
+    currentStamps.push_back(entry.Field->GetCurrentStamp());
+  }
   if (localized)
   {
     mask.assign(pixels, 0);
@@ -1907,11 +1914,11 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
       }
     }
   }
-  for (CutEntry& entry : impl.Cuts)
+  for (size_t n = 0; n < impl.Cuts.size(); ++n)
   {
     // Taken before casting: a brick the writer changes while rays are cast is
     // recast next time.
-    entry.RenderedStamp = entry.Field->GetCurrentStamp();
+    impl.Cuts[n].RenderedStamp = currentStamps[n];
   }
 
   std::vector<double> limits;
