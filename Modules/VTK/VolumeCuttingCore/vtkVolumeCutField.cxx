@@ -63,11 +63,8 @@ void Transform(const double m[4][4], const double in[3], double out[3])
 class CapsuleRowIntersector
 {
 public:
-  /// Without the start ball, the sweep ahead of p0: behind it the caller
-  /// clips, and ahead of it the ball lies within the cylinder and the end ball.
-  CapsuleRowIntersector(const double p0[3], const double p1[3], double radius, const double step[3], bool withStartBall = true)
+  CapsuleRowIntersector(const double p0[3], const double p1[3], double radius, const double step[3])
     : Radius2(radius * radius)
-    , WithStartBall(withStartBall)
   {
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -94,10 +91,7 @@ public:
   {
     first = std::numeric_limits<double>::max();
     last = -std::numeric_limits<double>::max();
-    if (this->WithStartBall)
-    {
-      this->Sphere(origin, this->P0, first, last);
-    }
+    this->Sphere(origin, this->P0, first, last);
     this->Sphere(origin, this->P1, first, last);
     if (this->Length > 0.0)
     {
@@ -184,7 +178,6 @@ private:
   double Axis[3];
   double Length = 0.0;
   double Radius2;
-  bool WithStartBall;
   double StepStep = 0.0;
   double StepAxis = 0.0;
   double CylinderA = 0.0;
@@ -365,15 +358,12 @@ void vtkVolumeCutField::Reset()
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
   this->ProtectionBricks.clear();
-  this->LastCapsule.Valid = false;
   this->ResetContact();
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::ResetContact()
 {
-  // The next capsule reports its whole reach again, the ball it starts in too.
-  this->LastCapsule.Valid = false;
   this->MaximumContactDepth = 0.0;
   this->ContactLabel = 0;
   std::fill(this->ContactPosition, this->ContactPosition + 3, 0.0);
@@ -389,7 +379,6 @@ const vtkVolumeCutField::ProtectionBrick* vtkVolumeCutField::GetProtectionBrick(
 bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
 {
   this->ProtectionBricks.clear();
-  this->LastCapsule.Valid = false; // what the last capsule could cut has changed
   if (!labels)
   {
     return true;
@@ -630,13 +619,10 @@ namespace
 class CapsuleSource : public vtkVolumeCutField::DistanceSource
 {
 public:
-  /// startCovered: the ball at p0 was cut already (a continued path), so
-  /// only samples ahead of p0 along the segment can change.
-  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3], bool startCovered)
+  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3])
     : Radius(radius)
     , Reach(reach)
-    , StartCovered(startCovered)
-    , Intersector(p0, p1, reach, rowStep, !startCovered)
+    , Intersector(p0, p1, reach, rowStep)
   {
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -655,33 +641,7 @@ public:
       upper[axis] = std::max(this->P0[axis], this->P1[axis]) + this->Reach;
     }
   }
-  bool RowInterval(const double origin[3], double& first, double& last) const override
-  {
-    if (!this->Intersector.Intersect(origin, first, last))
-    {
-      return false;
-    }
-    if (this->StartCovered && this->AbLength2 > 0.0)
-    {
-      // Behind p0 ((x - p0) . ab <= 0) the capsule's distance is the ball's
-      // at p0, which the field holds already.
-      const double ahead = (origin[0] - this->P0[0]) * this->Ab[0] + (origin[1] - this->P0[1]) * this->Ab[1] + (origin[2] - this->P0[2]) * this->Ab[2];
-      const double rate = this->Step[0] * this->Ab[0] + this->Step[1] * this->Ab[1] + this->Step[2] * this->Ab[2];
-      if (rate > 0.0)
-      {
-        first = std::max(first, -ahead / rate);
-      }
-      else if (rate < 0.0)
-      {
-        last = std::min(last, -ahead / rate);
-      }
-      else if (ahead <= 0.0)
-      {
-        return false;
-      }
-    }
-    return first <= last;
-  }
+  bool RowInterval(const double origin[3], double& first, double& last) const override { return this->Intersector.Intersect(origin, first, last); }
   void RowDistances(const double origin[3], int first, int last, float* distances) const override
   {
     // Single precision: the quantum is 1e-5 of the band, far above float
@@ -718,7 +678,6 @@ private:
   double AbLength2 = 0.0;
   double Radius;
   double Reach;
-  bool StartCovered;
   CapsuleRowIntersector Intersector;
 };
 } // namespace
@@ -959,10 +918,7 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
     return false;
   }
   const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
-  // The continued-path shortcut (startCovered) is off: with it the ray
-  // caster's thread test showed localized renders missing a change under
-  // load (4 in 60 runs), a race not yet found.
-  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep, false);
+  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep);
   this->ApplyDistance(source, operation);
   return true;
 }

@@ -328,20 +328,6 @@ protected:
   double Quantum = 1.0 / 32767.0;
   double HalfDiagonal = 0.5;
   double CorrectionReach = 1.0;
-
-  /// The last capsule cut, valid while nothing else has changed the field
-  /// (its stamp), the protection or the contact record: a capsule that
-  /// starts where it ended need not recompute the half ball behind its
-  /// start, which the last one already cut with the same distances.
-  /// Consecutive segments of a drill path are such capsules.
-  struct CapsuleContinuation
-  {
-    bool Valid = false;
-    double End[3] = { 0.0, 0.0, 0.0 };
-    double Radius = 0.0;
-    vtkTypeUInt64 Stamp = 0;
-  };
-  CapsuleContinuation LastCapsule;
   double MaximumStrokeLength = 50.0;
   double SubIJKToRAS[4][4];
   double AnatomyIJKToRAS[16];

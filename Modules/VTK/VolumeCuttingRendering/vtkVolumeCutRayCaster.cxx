@@ -119,15 +119,10 @@ void ParallelFor(int maximumThreads, vtkIdType end, Work&& work)
     work(vtkIdType(0), end);
     return;
   }
-  const bool sequentialDefault = std::strcmp(vtkSMPTools::GetBackend(), "Sequential") == 0;
-  vtkSMPTools::Config config;
-  if (sequentialDefault)
+  vtkSMPTools::Config config; // the active backend
+  if (std::strcmp(vtkSMPTools::GetBackend(), "Sequential") == 0)
   {
     config.Backend = "STDThread";
-  }
-  else
-  {
-    config.Backend = vtkSMPTools::GetBackend();
   }
   config.MaxNumberOfThreads = maximumThreads;
   vtkSMPTools::LocalScope(config, [&] { vtkSMPTools::For(0, end, work); });

@@ -180,9 +180,9 @@ int TestCapsuleAndStrokeEquivalence()
   return EXIT_SUCCESS;
 }
 
-// A capsule that starts where the last one ended skips the half ball behind
-// its start, which is already cut: only while nothing changed the field.
-int TestPathContinuationOnlyWhileUnchanged()
+// A drill path cut in segments: a segment after a restore or an undo cuts
+// its whole reach, and segments remove what one capsule removes.
+int TestSegmentedPathAfterRestoreAndUndo()
 {
   const int dims[3] = { 64, 48, 48 };
   vtkNew<vtkMatrix4x4> ijkToRas;
@@ -197,7 +197,6 @@ int TestPathContinuationOnlyWhileUnchanged()
   CHECK_BOOL(field->CutCapsule(a, m, radius), true);
   CHECK_BOOL(field->RestoreCapsule(m, m, radius), true);
   CHECK_BOOL(field->GetSignedDistance(behind) > 0.0, true);
-  // The restore changed the field: the next capsule must cut its whole ball.
   CHECK_BOOL(field->CutCapsule(m, b, radius), true);
   CHECK_BOOL(field->GetSignedDistance(behind) < 0.0, true);
 
@@ -209,7 +208,6 @@ int TestPathContinuationOnlyWhileUnchanged()
   CHECK_BOOL(undone->CutCapsule(m, b, radius), true);
   CHECK_BOOL(undone->GetSignedDistance(behind) < 0.0, true);
 
-  // A continued path removes exactly what one capsule removes.
   vtkNew<vtkVolumeCutField> continued;
   continued->Initialize(dims, ijkToRas, 2);
   continued->CutCapsule(a, m, radius);
@@ -424,7 +422,7 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestSphereAccuracy(false));
   CHECK_EXIT_SUCCESS(TestSphereAccuracy(true));
   CHECK_EXIT_SUCCESS(TestCapsuleAndStrokeEquivalence());
-  CHECK_EXIT_SUCCESS(TestPathContinuationOnlyWhileUnchanged());
+  CHECK_EXIT_SUCCESS(TestSegmentedPathAfterRestoreAndUndo());
   CHECK_EXIT_SUCCESS(TestRestoreUndoRedoAndStamps());
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
