@@ -1792,6 +1792,14 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     vtkErrorMacro("Render: needs a camera matrix and an image of 1 to 16384 pixels a side");
     return false;
   }
+  // The counters first, before the scene decides which fields have bricks
+  // (the active cuts): a brick stamped after this is listed next time, and
+  // one allocated before it is in the scene.
+  std::vector<vtkTypeUInt64> currentStamps;
+  for (CutEntry& entry : impl.Cuts)
+  {
+    currentStamps.push_back(entry.Field->GetCurrentStamp());
+  }
   bool sceneChanged = false;
   if (!this->PrepareScene(sceneChanged))
   {
@@ -1832,13 +1840,6 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
 
   // Which pixels to cast: all, or those covering bricks changed since the last image.
   std::vector<uint8_t> mask;
-  // Read before the modified bricks are listed: a brick stamped after this
-  // is listed next time (the field publishes a brick's stamp before its counter).
-  std::vector<vtkTypeUInt64> currentStamps;
-  for (CutEntry& entry : impl.Cuts)
-  {
-    currentStamps.push_back(entry.Field->GetCurrentStamp());
-  }
   if (localized)
   {
     mask.assign(pixels, 0);
