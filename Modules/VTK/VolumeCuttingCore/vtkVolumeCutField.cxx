@@ -56,133 +56,75 @@ void Transform(const double m[4][4], const double in[3], double out[3])
   }
 }
 
-/// Where a grid row, the line origin + t * step (t in sub-voxel index units),
-/// crosses a capsule. The capsule is convex, so the crossing is one interval:
-/// the hull of the row's crossings with the two end spheres and the finite
-/// cylinder between them.
-class CapsuleRowIntersector
+// The writer's inner loops run once per brick sample of every stroke: they
+// are built for AVX-512 and AVX2 besides the baseline, and the loader picks
+// what the processor has (GCC on Linux; elsewhere the baseline). The file is
+// compiled without floating-point contraction, so every variant rounds alike
+// and replays stay bitwise reproducible across machines.
+// Defining VOLUMECUTTING_VECTOR_CLONES empty builds the baseline alone, as
+// ThreadSanitizer needs (its runtime is not up when the loader picks).
+#ifndef VOLUMECUTTING_VECTOR_CLONES
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(__SANITIZE_THREAD__)
+#define VOLUMECUTTING_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define VOLUMECUTTING_VECTOR_CLONES
+#endif
+#endif
+
+/// Distances (mm, negative inside) of a brick's samples at w0 + offsets from
+/// the capsule of segment ab (from the origin) and radius; samples with
+/// (w . ab) / |ab|^2 below behindLimit are given far instead.
+VOLUMECUTTING_VECTOR_CLONES
+void CapsuleBrickDistances(const float w0[3], const float ab[3], float inverseLength2, float radius, float behindLimit, float far,
+  const float* offsets, float* distances)
 {
-public:
-  CapsuleRowIntersector(const double p0[3], const double p1[3], double radius, const double step[3])
-    : Radius2(radius * radius)
+  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
+  for (int n = 0; n < samples; ++n)
   {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      this->P0[axis] = p0[axis];
-      this->P1[axis] = p1[axis];
-      this->Step[axis] = step[axis];
-      this->Axis[axis] = p1[axis] - p0[axis];
-    }
-    this->Length = std::sqrt(Dot(this->Axis, this->Axis));
-    if (this->Length > 0.0)
-    {
-      for (double& component : this->Axis)
-      {
-        component /= this->Length;
-      }
-    }
-    this->StepStep = Dot(this->Step, this->Step);
-    this->StepAxis = Dot(this->Step, this->Axis);
-    this->CylinderA = this->StepStep - this->StepAxis * this->StepAxis;
-    this->InverseStepAxis = std::abs(this->StepAxis) > 1e-12 ? 1.0 / this->StepAxis : 0.0;
+    const float wx = w0[0] + offsets[n];
+    const float wy = w0[1] + offsets[samples + n];
+    const float wz = w0[2] + offsets[2 * samples + n];
+    const float ahead = (wx * ab[0] + wy * ab[1] + wz * ab[2]) * inverseLength2;
+    float along = ahead < 0.0f ? 0.0f : ahead;
+    along = along > 1.0f ? 1.0f : along;
+    const float dx = wx - along * ab[0];
+    const float dy = wy - along * ab[1];
+    const float dz = wz - along * ab[2];
+    const float distance = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
+    distances[n] = ahead < behindLimit ? far : distance;
   }
+}
 
-  bool Intersect(const double origin[3], double& first, double& last) const
+/// Distances to 16-bit samples: scaled, clamped to the band, rounded.
+VOLUMECUTTING_VECTOR_CLONES
+void QuantizeRun(const float* distances, int count, float scale, int16_t* quantized)
+{
+  const float insideF = static_cast<float>(Inside);
+  const float outsideF = static_cast<float>(Outside);
+  for (int n = 0; n < count; ++n)
   {
-    first = std::numeric_limits<double>::max();
-    last = -std::numeric_limits<double>::max();
-    this->Sphere(origin, this->P0, first, last);
-    this->Sphere(origin, this->P1, first, last);
-    if (this->Length > 0.0)
-    {
-      const double w[3] = { origin[0] - this->P0[0], origin[1] - this->P0[1], origin[2] - this->P0[2] };
-      const double wAxis = Dot(w, this->Axis);
-      // Cylinder: |w + t step|^2 - ((w + t step) . axis)^2 <= r^2.
-      const double a = this->CylinderA;
-      const double b = 2.0 * (Dot(w, this->Step) - wAxis * this->StepAxis);
-      const double c = Dot(w, w) - wAxis * wAxis - this->Radius2;
-      double t0;
-      double t1;
-      if (SolveInside(a, b, c, t0, t1))
-      {
-        // Between the end caps: 0 <= wAxis + t * stepAxis <= length.
-        if (std::abs(this->StepAxis) > 1e-12)
-        {
-          double s0 = -wAxis * this->InverseStepAxis;
-          double s1 = (this->Length - wAxis) * this->InverseStepAxis;
-          if (s0 > s1)
-          {
-            std::swap(s0, s1);
-          }
-          t0 = std::max(t0, s0);
-          t1 = std::min(t1, s1);
-        }
-        else if (wAxis < 0.0 || wAxis > this->Length)
-        {
-          t0 = 1.0;
-          t1 = 0.0;
-        }
-        if (t0 <= t1)
-        {
-          first = std::min(first, t0);
-          last = std::max(last, t1);
-        }
-      }
-    }
-    return first <= last;
+    float scaled = distances[n] * scale;
+    scaled = scaled < insideF ? insideF : scaled;
+    scaled = scaled > outsideF ? outsideF : scaled;
+    // Round to nearest through truncation of a positive number.
+    quantized[n] = static_cast<int16_t>(static_cast<int>(scaled + 32768.5f) - 32768);
   }
+}
 
-private:
-  static double Dot(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-  /// The interval of t where a t^2 + b t + c <= 0 (a >= 0); false if none.
-  static bool SolveInside(double a, double b, double c, double& t0, double& t1)
+/// merged = min(current, quantized); whether any sample changed.
+VOLUMECUTTING_VECTOR_CLONES
+bool MinimumRun(const int16_t* quantized, const int16_t* current, int count, int16_t* merged)
+{
+  int changed = 0;
+  for (int n = 0; n < count; ++n)
   {
-    if (a <= 1e-15)
-    {
-      if (c > 0.0)
-      {
-        return false; // parallel to the axis and outside
-      }
-      t0 = -std::numeric_limits<double>::max();
-      t1 = std::numeric_limits<double>::max();
-      return true;
-    }
-    const double discriminant = b * b - 4.0 * a * c;
-    if (discriminant < 0.0)
-    {
-      return false;
-    }
-    const double root = std::sqrt(discriminant);
-    const double inverseTwoA = 0.5 / a;
-    t0 = (-b - root) * inverseTwoA;
-    t1 = (-b + root) * inverseTwoA;
-    return true;
+    merged[n] = quantized[n] < current[n] ? quantized[n] : current[n];
+    changed |= merged[n] != current[n];
   }
+  return changed != 0;
+}
 
-  void Sphere(const double origin[3], const double center[3], double& first, double& last) const
-  {
-    const double w[3] = { origin[0] - center[0], origin[1] - center[1], origin[2] - center[2] };
-    double t0;
-    double t1;
-    if (SolveInside(this->StepStep, 2.0 * Dot(w, this->Step), Dot(w, w) - this->Radius2, t0, t1))
-    {
-      first = std::min(first, t0);
-      last = std::max(last, t1);
-    }
-  }
 
-  double P0[3];
-  double P1[3];
-  double Step[3];
-  double Axis[3];
-  double Length = 0.0;
-  double Radius2;
-  double StepStep = 0.0;
-  double StepAxis = 0.0;
-  double CylinderA = 0.0;
-  double InverseStepAxis = 0.0;
-};
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -201,7 +143,13 @@ struct vtkVolumeCutField::Brick
   std::atomic<uint32_t> Sequence{ 0 };
   std::atomic<vtkTypeUInt64> Stamp{ 0 };
   std::atomic<int16_t> Values[SamplesPerBrick];
+
+  /// The values as the writer thread sees them, for loops that vectorise:
+  /// other threads only read, so the writer's own plain reads race with
+  /// nothing (lock-free 16-bit atomics have the layout of the integer).
+  const int16_t* WriterView() const { return reinterpret_cast<const int16_t*>(this->Values); }
 };
+static_assert(sizeof(std::atomic<int16_t>) == sizeof(int16_t), "16-bit atomics must have the layout of the integer");
 
 //------------------------------------------------------------------------------
 struct vtkVolumeCutField::ProtectionBrick
@@ -334,6 +282,33 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
   this->CorrectionReach = 3.0 * std::max({ spacing[0], spacing[1], spacing[2] });
   this->RowScratch.assign(static_cast<size_t>(BrickSize) * BrickSize * dimensions[0], Outside);
   this->DistanceScratch.assign(static_cast<size_t>(dimensions[0]), 0.0f);
+  this->BrickSampleOffsets.resize(3 * SamplesPerBrick);
+  for (int local = 0; local < SamplesPerBrick; ++local)
+  {
+    const int step[3] = { local % BrickSize, (local / BrickSize) % BrickSize, local / (BrickSize * BrickSize) };
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      this->BrickSampleOffsets[axis * SamplesPerBrick + local] = static_cast<float>(
+        step[0] * this->SubIJKToRAS[axis][0] + step[1] * this->SubIJKToRAS[axis][1] + step[2] * this->SubIJKToRAS[axis][2]);
+    }
+  }
+  // Half the longest of the four diagonals (oblique grids have unequal ones).
+  this->BrickBoundingRadius = 0.0;
+  for (int diagonal = 0; diagonal < 4; ++diagonal)
+  {
+    const double signs[3] = { 1.0, diagonal & 1 ? -1.0 : 1.0, diagonal & 2 ? -1.0 : 1.0 };
+    double length2 = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      double component = 0.0;
+      for (int column = 0; column < 3; ++column)
+      {
+        component += signs[column] * (BrickSize - 1) * this->SubIJKToRAS[axis][column];
+      }
+      length2 += component * component;
+    }
+    this->BrickBoundingRadius = std::max(this->BrickBoundingRadius, 0.5 * std::sqrt(length2));
+  }
   const vtkIdType totalBricks = static_cast<vtkIdType>(brickCount);
   this->Directory.reset(new std::atomic<Brick*>[totalBricks]);
   this->AllocatedBrickIds.reset(new std::atomic<vtkIdType>[totalBricks]);
@@ -358,12 +333,15 @@ void vtkVolumeCutField::Reset()
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
   this->ProtectionBricks.clear();
+  this->LastCapsule.Valid = false;
   this->ResetContact();
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::ResetContact()
 {
+  // The next capsule reports its whole reach again, the ball it starts in too.
+  this->LastCapsule.Valid = false;
   this->MaximumContactDepth = 0.0;
   this->ContactLabel = 0;
   std::fill(this->ContactPosition, this->ContactPosition + 3, 0.0);
@@ -379,6 +357,7 @@ const vtkVolumeCutField::ProtectionBrick* vtkVolumeCutField::GetProtectionBrick(
 bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
 {
   this->ProtectionBricks.clear();
+  this->LastCapsule.Valid = false; // what the last capsule could cut has changed
   if (!labels)
   {
     return true;
@@ -614,22 +593,23 @@ void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick
 //------------------------------------------------------------------------------
 namespace
 {
-/// The sweep of a sphere: a capsule, with closed-form row intervals and a
+/// The sweep of a sphere: a capsule, written a brick at a time with a
 /// vectorised distance loop.
-class CapsuleSource : public vtkVolumeCutField::DistanceSource
+class CapsuleSource : public vtkVolumeCutField::BrickDistanceSource
 {
 public:
-  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, const double rowStep[3])
+  /// startCovered: the ball at p0 was cut already (a continued path), so
+  /// only samples ahead of p0 along the segment can change.
+  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, bool startCovered)
     : Radius(radius)
     , Reach(reach)
-    , Intersector(p0, p1, reach, rowStep)
+    , StartCovered(startCovered)
   {
     for (int axis = 0; axis < 3; ++axis)
     {
       this->P0[axis] = p0[axis];
       this->P1[axis] = p1[axis];
       this->Ab[axis] = p1[axis] - p0[axis];
-      this->Step[axis] = rowStep[axis];
     }
     this->AbLength2 = this->Ab[0] * this->Ab[0] + this->Ab[1] * this->Ab[1] + this->Ab[2] * this->Ab[2];
   }
@@ -641,44 +621,41 @@ public:
       upper[axis] = std::max(this->P0[axis], this->P1[axis]) + this->Reach;
     }
   }
-  bool RowInterval(const double origin[3], double& first, double& last) const override { return this->Intersector.Intersect(origin, first, last); }
-  void RowDistances(const double origin[3], int first, int last, float* distances) const override
+  double Distance(const double point[3]) const override { return DistanceToSegment(point, this->P0, this->Ab, this->AbLength2) - this->Radius; }
+
+  bool MayReach(const double center[3], double radius) const override
   {
-    // Single precision: the quantum is 1e-5 of the band, far above float
-    // rounding at these distances; the loop vectorises.
-    const float w0[3] = { static_cast<float>(origin[0] + first * this->Step[0] - this->P0[0]),
-      static_cast<float>(origin[1] + first * this->Step[1] - this->P0[1]), static_cast<float>(origin[2] + first * this->Step[2] - this->P0[2]) };
-    const float step[3] = { static_cast<float>(this->Step[0]), static_cast<float>(this->Step[1]), static_cast<float>(this->Step[2]) };
+    if (DistanceToSegment(center, this->P0, this->Ab, this->AbLength2) - radius > this->Reach)
+    {
+      return false;
+    }
+    if (this->StartCovered && this->AbLength2 > 0.0)
+    {
+      const double ahead = (center[0] - this->P0[0]) * this->Ab[0] + (center[1] - this->P0[1]) * this->Ab[1] + (center[2] - this->P0[2]) * this->Ab[2];
+      return ahead + radius * std::sqrt(this->AbLength2) > 0.0;
+    }
+    return true;
+  }
+  void BrickDistances(const double origin[3], const float* offsets, float* distances) const override
+  {
+    const float w0[3] = { static_cast<float>(origin[0] - this->P0[0]), static_cast<float>(origin[1] - this->P0[1]),
+      static_cast<float>(origin[2] - this->P0[2]) };
     const float ab[3] = { static_cast<float>(this->Ab[0]), static_cast<float>(this->Ab[1]), static_cast<float>(this->Ab[2]) };
     const float inverseLength2 = this->AbLength2 > 0.0 ? static_cast<float>(1.0 / this->AbLength2) : 0.0f;
-    const float radius = static_cast<float>(this->Radius);
-    const int count = last - first + 1;
-    for (int n = 0; n < count; ++n)
-    {
-      const float t = static_cast<float>(n);
-      const float wx = w0[0] + t * step[0];
-      const float wy = w0[1] + t * step[1];
-      const float wz = w0[2] + t * step[2];
-      float along = (wx * ab[0] + wy * ab[1] + wz * ab[2]) * inverseLength2;
-      along = along < 0.0f ? 0.0f : along;
-      along = along > 1.0f ? 1.0f : along;
-      const float dx = wx - along * ab[0];
-      const float dy = wy - along * ab[1];
-      const float dz = wz - along * ab[2];
-      distances[n] = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
-    }
+    // Behind the start of a continued path the field holds the ball already:
+    // far away there means unchanged.
+    const float behindLimit = this->StartCovered && this->AbLength2 > 0.0 ? 0.0f : -std::numeric_limits<float>::infinity();
+    CapsuleBrickDistances(w0, ab, inverseLength2, static_cast<float>(this->Radius), behindLimit, static_cast<float>(2.0 * this->Reach), offsets, distances);
   }
-  double Distance(const double point[3]) const override { return DistanceToSegment(point, this->P0, this->Ab, this->AbLength2) - this->Radius; }
 
 private:
   double P0[3];
   double P1[3];
   double Ab[3];
-  double Step[3];
   double AbLength2 = 0.0;
   double Radius;
   double Reach;
-  CapsuleRowIntersector Intersector;
+  bool StartCovered;
 };
 } // namespace
 
@@ -693,7 +670,7 @@ struct RigidPose
 
 /// The sweep of any tool: the tool at poses close enough that the union of
 /// its copies covers the continuous sweep to within half a sub-voxel.
-class SweptToolSource : public vtkVolumeCutField::DistanceSource
+class SweptToolSource : public vtkVolumeCutField::RowDistanceSource
 {
 public:
   SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach, const double rowStep[3])
@@ -917,21 +894,29 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
   {
     return false;
   }
-  const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
-  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, rowStep);
+  const CapsuleContinuation& last = this->LastCapsule;
+  const bool continued = operation == Operation::Cut && last.Valid && last.Stamp == this->GetCurrentStamp() && last.Radius == radius &&
+    last.End[0] == p0[0] && last.End[1] == p0[1] && last.End[2] == p0[2];
+  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, continued);
   this->ApplyDistance(source, operation);
+  this->LastCapsule.Valid = operation == Operation::Cut;
+  std::copy(p1, p1 + 3, this->LastCapsule.End);
+  this->LastCapsule.Radius = radius;
+  this->LastCapsule.Stamp = this->GetCurrentStamp();
   return true;
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation operation)
+bool vtkVolumeCutField::GetReachIndexRange(const DistanceSource& source, int lower[3], int upper[3]) const
 {
-  // Sub-voxel index range of the reach box.
   double reachLower[3];
   double reachUpper[3];
   source.GetReachBounds(reachLower, reachUpper);
-  int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
-  int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    lower[axis] = std::numeric_limits<int>::max();
+    upper[axis] = std::numeric_limits<int>::min();
+  }
   for (int corner = 0; corner < 8; ++corner)
   {
     double ras[3];
@@ -955,23 +940,151 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
     upper[axis] = std::min(upper[axis], this->Dimensions[axis] - 1);
     if (lower[axis] > upper[axis])
     {
-      return; // wholly outside the volume: nothing to do
+      return false;
     }
   }
+  return true;
+}
 
+//------------------------------------------------------------------------------
+template <typename Writer>
+void vtkVolumeCutField::ApplyWithinStroke(const DistanceSource& source, Writer&& write)
+{
+  int lower[3];
+  int upper[3];
+  if (!this->GetReachIndexRange(source, lower, upper))
+  {
+    return; // wholly outside the volume: nothing to do
+  }
   const bool ownStroke = !this->StrokeOpen;
   if (ownStroke)
   {
     this->BeginStroke();
   }
-  const float inverseQuantum = static_cast<float>(1.0 / this->Quantum);
-  const float insideF = static_cast<float>(Inside);
-  const float outsideF = static_cast<float>(Outside);
-  const float sign = operation == Operation::Cut ? 1.0f : -1.0f;
-  int16_t changedValues[SamplesPerBrick];
-  int changedIndices[SamplesPerBrick];
-  bool anyChange = false;
+  const bool anyChange = write(lower, upper);
+  if (ownStroke)
+  {
+    this->EndStroke();
+  }
+  if (anyChange)
+  {
+    this->Modified();
+  }
+}
 
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ApplyDistance(const RowDistanceSource& source, Operation operation)
+{
+  this->ApplyWithinStroke(source, [&](const int lower[3], const int upper[3]) { return this->ApplyRowwise(source, operation, lower, upper); });
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ApplyDistance(const BrickDistanceSource& source, Operation operation)
+{
+  this->ApplyWithinStroke(source, [&](const int lower[3], const int upper[3]) { return this->ApplyBrickwise(source, operation, lower, upper); });
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::QuantizeDistances(const float* distances, int count, Operation operation, int16_t* quantized) const
+{
+  QuantizeRun(distances, count, static_cast<float>((operation == Operation::Cut ? 1.0 : -1.0) / this->Quantum), quantized);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::MergeSegment(const Brick* brick, const ProtectionBrick* protection, const int brickIndex[3], const int16_t* quantized,
+  int rowStart, int count, Operation operation, const DistanceSource& source, int16_t* merged)
+{
+  // Cut: min(field, tool distance). Restore: max(field, -tool distance).
+  // The brick is read directly: this thread is its only writer.
+  const int16_t* current = brick ? brick->WriterView() + rowStart : nullptr;
+  int changed = 0;
+  if (operation == Operation::Cut && !protection)
+  {
+    if (current)
+    {
+      return MinimumRun(quantized, current, count, merged);
+    }
+    else
+    {
+      for (int n = 0; n < count; ++n)
+      {
+        merged[n] = quantized[n];
+        changed |= quantized[n] != Outside;
+      }
+    }
+    return changed != 0;
+  }
+  if (operation == Operation::Restore)
+  {
+    for (int n = 0; n < count; ++n)
+    {
+      const int16_t old = current ? current[n] : Outside;
+      merged[n] = quantized[n] > old ? quantized[n] : old;
+      changed |= merged[n] != old;
+    }
+    return changed != 0;
+  }
+  // The tool minus the protected voxels: max(tool, -protection).
+  for (int n = 0; n < count; ++n)
+  {
+    const int16_t old = current ? current[n] : Outside;
+    const int local = rowStart + n;
+    const int16_t protectedDistance = protection->Distance[local];
+    const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
+    if (quantized[n] < 0 && protectedDistance < 0)
+    {
+      // A protected sample inside the tool: how far inside (exact, not
+      // clamped to the band) is the depth of the contact.
+      const double index[3] = { double(brickIndex[0] * BrickSize + local % BrickSize),
+        double(brickIndex[1] * BrickSize + (local / BrickSize) % BrickSize), double(brickIndex[2] * BrickSize + local / (BrickSize * BrickSize)) };
+      double point[3];
+      Transform(this->SubIJKToRAS, index, point);
+      const double depth = -source.Distance(point);
+      if (depth > this->MaximumContactDepth)
+      {
+        this->MaximumContactDepth = depth;
+        this->ContactLabel = protection->Label[local];
+        std::copy(point, point + 3, this->ContactPosition);
+      }
+    }
+    merged[n] = effective < old ? effective : old;
+    changed |= merged[n] != old;
+  }
+  return changed != 0;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16_t* merged, const ChangedRun* runs, int runCount)
+{
+  this->RememberBrickBeforeChange(brickId, brick);
+  if (!brick)
+  {
+    brick = this->GetOrCreateBrick(brickId);
+  }
+  // Seqlock write: readers that overlap it see an odd or changed sequence and retry.
+  const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
+  brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
+  std::atomic_thread_fence(std::memory_order_release);
+  for (int r = 0; r < runCount; ++r)
+  {
+    for (int n = runs[r].Start; n < runs[r].Start + runs[r].Count; ++n)
+    {
+      brick->Values[n].store(merged[n], std::memory_order_relaxed);
+    }
+  }
+  // One writer: the brick's stamp is published before the counter passes
+  // it, so a reader that has seen the counter sees the brick as modified.
+  const vtkTypeUInt64 stamp = this->StampCounter.load(std::memory_order_relaxed) + 1;
+  brick->Stamp.store(stamp, std::memory_order_release);
+  this->StampCounter.store(stamp, std::memory_order_release);
+  brick->Sequence.store(sequence + 2, std::memory_order_release);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ApplyRowwise(const RowDistanceSource& source, Operation operation, const int lower[3], const int upper[3])
+{
+  // Where each row crosses the reach is computed once per line of bricks,
+  // then split among the bricks along it.
   struct Row
   {
     int First;
@@ -979,12 +1092,13 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
     int LocalOffset; // (k, j) part of the sample index inside the brick
   };
   Row rows[BrickSize * BrickSize];
+  int16_t merged[SamplesPerBrick];
+  ChangedRun runs[BrickSize * BrickSize];
+  bool anyChange = false;
   for (int bk = lower[2] / BrickSize; bk <= upper[2] / BrickSize; ++bk)
   {
     for (int bj = lower[1] / BrickSize; bj <= upper[1] / BrickSize; ++bj)
     {
-      // Rows of this line of bricks: where each crosses the reach is
-      // computed once, then split among the bricks along it.
       int rowCount = 0;
       for (int k = std::max(lower[2], bk * BrickSize); k <= std::min(upper[2], bk * BrickSize + BrickSize - 1); ++k)
       {
@@ -1009,24 +1123,12 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
           row.LocalOffset = ((k - bk * BrickSize) * BrickSize + (j - bj * BrickSize)) * BrickSize;
           float* distances = &this->DistanceScratch[row.First];
           source.RowDistances(origin, row.First, row.Last, distances);
-          int16_t* quantized = &this->RowScratch[static_cast<size_t>(rowCount) * this->Dimensions[0] + row.First];
-          const int count = row.Last - row.First + 1;
-          for (int n = 0; n < count; ++n)
-          {
-            float scaled = sign * distances[n] * inverseQuantum;
-            scaled = scaled < insideF ? insideF : scaled;
-            scaled = scaled > outsideF ? outsideF : scaled;
-            // Round to nearest through truncation of a positive number.
-            quantized[n] = static_cast<int16_t>(static_cast<int>(scaled + 32768.5f) - 32768);
-          }
+          this->QuantizeDistances(distances, row.Last - row.First + 1, operation,
+            &this->RowScratch[static_cast<size_t>(rowCount) * this->Dimensions[0] + row.First]);
           ++rowCount;
         }
       }
-      if (rowCount == 0)
-      {
-        continue;
-      }
-      for (int bi = lower[0] / BrickSize; bi <= upper[0] / BrickSize; ++bi)
+      for (int bi = lower[0] / BrickSize; rowCount > 0 && bi <= upper[0] / BrickSize; ++bi)
       {
         const vtkIdType brickId = (static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi;
         Brick* brick = this->Directory[brickId].load(std::memory_order_relaxed);
@@ -1035,7 +1137,8 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
           continue; // nothing removed here, nothing to put back
         }
         const ProtectionBrick* protection = this->GetProtectionBrick(brickId);
-        int changes = 0;
+        const int brickIndex[3] = { bi, bj, bk };
+        int runCount = 0;
         for (int r = 0; r < rowCount; ++r)
         {
           const Row& row = rows[r];
@@ -1045,110 +1148,107 @@ void vtkVolumeCutField::ApplyDistance(const DistanceSource& source, Operation op
           {
             continue;
           }
-          const int count = iEnd - iBegin + 1;
-          const int16_t* quantized = &this->RowScratch[static_cast<size_t>(r) * this->Dimensions[0] + iBegin];
           const int rowStart = row.LocalOffset + (iBegin - bi * BrickSize);
-          // Cut: min(field, tool distance). Restore: max(field, -tool distance).
-          int16_t* merged = &changedValues[changes];
-          int rowChanged = 0;
-          if (operation == Operation::Cut && !protection)
+          const int count = iEnd - iBegin + 1;
+          if (this->MergeSegment(brick, protection, brickIndex, &this->RowScratch[static_cast<size_t>(r) * this->Dimensions[0] + iBegin], rowStart,
+                count, operation, source, merged + rowStart))
           {
-            // The common case, read straight from the brick (this thread is its only writer).
-            for (int n = 0; n < count; ++n)
-            {
-              const int16_t old = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
-              merged[n] = quantized[n] < old ? quantized[n] : old;
-              rowChanged |= merged[n] != old;
-            }
+            runs[runCount++] = { rowStart, count };
           }
-          else
+        }
+        if (runCount > 0)
+        {
+          this->CommitBrick(brickId, brick, merged, runs, runCount);
+          anyChange = true;
+        }
+      }
+    }
+  }
+  return anyChange;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operation operation, const int lower[3], const int upper[3])
+{
+  // Whole bricks in one uniform loop each: near a small tool the rows are a
+  // few samples long, and their set-up, not the distances, would dominate.
+  float distances[SamplesPerBrick];
+  int16_t quantized[SamplesPerBrick];
+  int16_t merged[SamplesPerBrick];
+  ChangedRun runs[BrickSize * BrickSize];
+  bool anyChange = false;
+  for (int bk = lower[2] / BrickSize; bk <= upper[2] / BrickSize; ++bk)
+  {
+    for (int bj = lower[1] / BrickSize; bj <= upper[1] / BrickSize; ++bj)
+    {
+      for (int bi = lower[0] / BrickSize; bi <= upper[0] / BrickSize; ++bi)
+      {
+        const vtkIdType brickId = (static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi;
+        Brick* brick = this->Directory[brickId].load(std::memory_order_relaxed);
+        if (!brick && operation == Operation::Restore)
+        {
+          continue; // nothing removed here, nothing to put back
+        }
+        const int brickIndex[3] = { bi, bj, bk };
+        const double firstSample[3] = { double(bi * BrickSize), double(bj * BrickSize), double(bk * BrickSize) };
+        const double middle = 0.5 * (BrickSize - 1);
+        const double centerSample[3] = { firstSample[0] + middle, firstSample[1] + middle, firstSample[2] + middle };
+        double center[3];
+        Transform(this->SubIJKToRAS, centerSample, center);
+        if (!source.MayReach(center, this->BrickBoundingRadius))
+        {
+          continue;
+        }
+        double origin[3];
+        Transform(this->SubIJKToRAS, firstSample, origin);
+        source.BrickDistances(origin, this->BrickSampleOffsets.data(), distances);
+        this->QuantizeDistances(distances, SamplesPerBrick, operation, quantized);
+
+        // Samples past the volume's far faces exist in the brick, not in the field.
+        const int valid[3] = { std::min(BrickSize, this->Dimensions[0] - bi * BrickSize), std::min(BrickSize, this->Dimensions[1] - bj * BrickSize),
+          std::min(BrickSize, this->Dimensions[2] - bk * BrickSize) };
+        const ProtectionBrick* protection = this->GetProtectionBrick(brickId);
+        const bool whole = valid[0] == BrickSize && valid[1] == BrickSize && valid[2] == BrickSize;
+        if (whole && !this->MergeSegment(brick, protection, brickIndex, quantized, 0, SamplesPerBrick, operation, source, merged))
+        {
+          continue;
+        }
+        // Rows that changed: the seqlock write stores only those.
+        int runCount = 0;
+        for (int k = 0; k < valid[2]; ++k)
+        {
+          for (int j = 0; j < valid[1]; ++j)
           {
-            int16_t old[BrickSize];
-            for (int n = 0; n < count; ++n)
+            const int rowStart = (k * BrickSize + j) * BrickSize;
+            bool changed;
+            if (whole)
             {
-              old[n] = brick ? brick->Values[rowStart + n].load(std::memory_order_relaxed) : Outside;
-            }
-            if (operation == Operation::Cut)
-            {
-              // The tool minus the protected voxels: max(tool, -protection).
-              for (int n = 0; n < count; ++n)
+              const int16_t* current = brick ? brick->WriterView() + rowStart : nullptr;
+              changed = false;
+              for (int n = 0; n < BrickSize; ++n)
               {
-                const int16_t protectedDistance = protection->Distance[rowStart + n];
-                const int16_t effective = std::max<int16_t>(quantized[n], static_cast<int16_t>(-protectedDistance));
-                if (quantized[n] < 0 && protectedDistance < 0)
-                {
-                  // A protected sample inside the tool: how far inside (exact,
-                  // not clamped to the band) is the depth of the contact.
-                  const int local = rowStart + n;
-                  const double index[3] = { double(bi * BrickSize + local % BrickSize), double(bj * BrickSize + (local / BrickSize) % BrickSize),
-                    double(bk * BrickSize + local / (BrickSize * BrickSize)) };
-                  double point[3];
-                  Transform(this->SubIJKToRAS, index, point);
-                  const double depth = -source.Distance(point);
-                  if (depth > this->MaximumContactDepth)
-                  {
-                    this->MaximumContactDepth = depth;
-                    this->ContactLabel = protection->Label[local];
-                    std::copy(point, point + 3, this->ContactPosition);
-                  }
-                }
-                merged[n] = effective < old[n] ? effective : old[n];
-                rowChanged |= merged[n] != old[n];
+                changed |= merged[rowStart + n] != (current ? current[n] : Outside);
               }
             }
             else
             {
-              for (int n = 0; n < count; ++n)
-              {
-                merged[n] = quantized[n] > old[n] ? quantized[n] : old[n];
-                rowChanged |= merged[n] != old[n];
-              }
+              changed = this->MergeSegment(brick, protection, brickIndex, quantized + rowStart, rowStart, valid[0], operation, source, merged + rowStart);
             }
-          }
-          if (rowChanged)
-          {
-            for (int n = 0; n < count; ++n)
+            if (changed)
             {
-              changedIndices[changes + n] = rowStart + n;
+              runs[runCount++] = { rowStart, valid[0] };
             }
-            changes += count;
           }
         }
-        if (changes == 0)
+        if (runCount > 0)
         {
-          continue;
+          this->CommitBrick(brickId, brick, merged, runs, runCount);
+          anyChange = true;
         }
-        this->RememberBrickBeforeChange(brickId, brick);
-        if (!brick)
-        {
-          brick = this->GetOrCreateBrick(brickId);
-        }
-        // Seqlock write: readers that overlap it see an odd or changed sequence and retry.
-        const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
-        brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
-        std::atomic_thread_fence(std::memory_order_release);
-        for (int n = 0; n < changes; ++n)
-        {
-          brick->Values[changedIndices[n]].store(changedValues[n], std::memory_order_relaxed);
-        }
-        // One writer: the brick's stamp is published before the counter passes
-        // it, so a reader that has seen the counter sees the brick as modified.
-        const vtkTypeUInt64 stamp = this->StampCounter.load(std::memory_order_relaxed) + 1;
-        brick->Stamp.store(stamp, std::memory_order_release);
-        this->StampCounter.store(stamp, std::memory_order_release);
-        brick->Sequence.store(sequence + 2, std::memory_order_release);
-        anyChange = true;
       }
     }
   }
-  if (ownStroke)
-  {
-    this->EndStroke();
-  }
-  if (anyChange)
-  {
-    this->Modified();
-  }
+  return anyChange;
 }
 
 //------------------------------------------------------------------------------

@@ -292,8 +292,11 @@ protected:
   struct ProtectionBrick;
 
 public:
-  /// Internal: a tool sweep's reach and distances (defined in the .cxx).
+  /// Internal: a tool sweep's reach and distances, written row by row or a
+  /// brick at a time (vtkVolumeCutFieldDistanceSource.h).
   struct DistanceSource;
+  struct RowDistanceSource;
+  struct BrickDistanceSource;
 
 protected:
   struct UndoStep;
@@ -305,8 +308,32 @@ protected:
 
   using BrickValues = std::vector<int16_t>;
 
+  /// Samples [Start, Start + Count) of a brick that a merge changed.
+  struct ChangedRun
+  {
+    int Start;
+    int Count;
+  };
+
   bool ApplyCapsule(const double p0[3], const double p1[3], double radius, Operation operation);
-  void ApplyDistance(const DistanceSource& source, Operation operation);
+  void ApplyDistance(const RowDistanceSource& source, Operation operation);
+  void ApplyDistance(const BrickDistanceSource& source, Operation operation);
+  /// The sub-voxel index box of a source's reach; false when it misses the volume.
+  bool GetReachIndexRange(const DistanceSource& source, int lower[3], int upper[3]) const;
+  /// Runs write(lower, upper) over a source's reach within a stroke (its own
+  /// unless one is open); write returns whether it changed anything.
+  template <typename Writer>
+  void ApplyWithinStroke(const DistanceSource& source, Writer&& write);
+  bool ApplyRowwise(const RowDistanceSource& source, Operation operation, const int lower[3], const int upper[3]);
+  bool ApplyBrickwise(const BrickDistanceSource& source, Operation operation, const int lower[3], const int upper[3]);
+  void QuantizeDistances(const float* distances, int count, Operation operation, int16_t* quantized) const;
+  /// Merges a run of quantised tool distances into a brick (null: not
+  /// allocated) at sample rowStart; records contacts with protected samples.
+  bool MergeSegment(const Brick* brick, const ProtectionBrick* protection, const int brickIndex[3], const int16_t* quantized, int rowStart,
+    int count, Operation operation, const DistanceSource& source, int16_t* merged);
+  /// Stores the changed runs of merged (a whole brick's layout) under the
+  /// brick's seqlock, remembering the brick for undo first.
+  void CommitBrick(vtkIdType brickId, Brick* brick, const int16_t* merged, const ChangedRun* runs, int runCount);
   bool ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, Operation operation);
   bool ValidateStroke(const double p0[3], const double p1[3], double radius, const char* caller) const;
   Brick* GetOrCreateBrick(vtkIdType brickId);
@@ -328,6 +355,20 @@ protected:
   double Quantum = 1.0 / 32767.0;
   double HalfDiagonal = 0.5;
   double CorrectionReach = 1.0;
+
+  /// The last capsule cut, valid while nothing else has changed the field
+  /// (its stamp), the protection or the contact record: a capsule that
+  /// starts where it ended need not recompute the half ball behind its
+  /// start, which the last one already cut with the same distances.
+  /// Consecutive segments of a drill path are such capsules.
+  struct CapsuleContinuation
+  {
+    bool Valid = false;
+    double End[3] = { 0.0, 0.0, 0.0 };
+    double Radius = 0.0;
+    vtkTypeUInt64 Stamp = 0;
+  };
+  CapsuleContinuation LastCapsule;
   double MaximumStrokeLength = 50.0;
   double SubIJKToRAS[4][4];
   double AnatomyIJKToRAS[16];
@@ -351,6 +392,10 @@ protected:
   // Writer's scratch: quantised tool distances of the rows of one line of bricks.
   std::vector<int16_t> RowScratch;
   std::vector<float> DistanceScratch;
+  // RAS offsets of a brick's samples from its first (x, then y, then z, each
+  // SamplesPerBrick long) and the radius of a ball about its centre holding them.
+  std::vector<float> BrickSampleOffsets;
+  double BrickBoundingRadius = 0.0;
   bool StrokeOpen = false;
   // Bricks touched by the open stroke: their values before it began.
   std::map<vtkIdType, BrickValues> StrokeBefore;

@@ -9,19 +9,36 @@
 #include "vtkVolumeCutField.h"
 
 /// What ApplyDistance needs to know of a tool sweep: where it reaches and its
-/// signed distance (mm, negative inside), per grid row or at a point.
+/// signed distance (mm, negative inside) at a point.
 struct vtkVolumeCutField::DistanceSource
 {
   virtual ~DistanceSource() = default;
   /// RAS box holding every point within reach (the swept tool grown by the band).
   virtual void GetReachBounds(double lower[3], double upper[3]) const = 0;
-  /// Stretch [first, last] (row index units) of the row origin + t * step within reach.
-  virtual bool RowInterval(const double origin[3], double& first, double& last) const = 0;
-  /// Distances at t = first .. last into distances[0 .. last - first].
-  virtual void RowDistances(const double origin[3], int first, int last, float* distances) const = 0;
   /// Distance at one point (contacts).
   virtual double Distance(const double point[3]) const = 0;
 };
 
+/// A sweep written row by row: for tools whose distance is costly, where the
+/// exact stretch of each grid row within reach saves most evaluations.
+struct vtkVolumeCutField::RowDistanceSource : vtkVolumeCutField::DistanceSource
+{
+  /// Stretch [first, last] (row index units) of the row origin + t * step within reach.
+  virtual bool RowInterval(const double origin[3], double& first, double& last) const = 0;
+  /// Distances at t = first .. last into distances[0 .. last - first].
+  virtual void RowDistances(const double origin[3], int first, int last, float* distances) const = 0;
+};
+
+/// A sweep written a brick at a time: for tools whose distance is cheap
+/// everywhere, one long vectorised loop per brick costs less than setting up
+/// many short rows.
+struct vtkVolumeCutField::BrickDistanceSource : vtkVolumeCutField::DistanceSource
+{
+  /// False when no point within radius of center is within reach.
+  virtual bool MayReach(const double center[3], double radius) const = 0;
+  /// Distances at origin + offsets, the field's brick sample offsets (x, y
+  /// and z runs of BrickSize^3 each).
+  virtual void BrickDistances(const double origin[3], const float* offsets, float* distances) const = 0;
+};
 
 #endif

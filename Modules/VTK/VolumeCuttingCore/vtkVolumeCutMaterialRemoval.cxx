@@ -18,7 +18,7 @@ namespace
 {
 /// The burr's distance at the samples whose exposure reached what their
 /// density requires, and "far" (no change) everywhere else.
-class DepletedBurrSource : public vtkVolumeCutField::DistanceSource
+class DepletedBurrSource : public vtkVolumeCutField::RowDistanceSource
 {
 public:
   using ExposureMap = std::unordered_map<vtkIdType, std::array<float, 512>>;

@@ -15,7 +15,9 @@
 #include <vtkPointData.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
+#include <vector>
 
 namespace
 {
@@ -219,6 +221,85 @@ int TestSegmentedPathAfterRestoreAndUndo()
   return EXIT_SUCCESS;
 }
 
+
+// Every stored sample is the exact clamped distance to the cut, on an oblique
+// grid whose sizes are not whole bricks; samples of the last bricks that lie
+// past the volume's far faces are never written.
+int TestStoredDistancesAtTheFarFaces()
+{
+  const int dims[3] = { 21, 19, 17 }; // 42 x 38 x 34 sub-voxels: partial bricks on every far face
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  MakeObliqueGrid(ijkToRas);
+  vtkNew<vtkVolumeCutField> field;
+  CHECK_BOOL(field->Initialize(dims, ijkToRas, 2), true);
+  // A path ending beyond the far corner; its segments continue one another.
+  double corner[3];
+  const double farIndex[4] = { dims[0] - 1.0, dims[1] - 1.0, dims[2] - 1.0, 1.0 };
+  double farRas[4];
+  ijkToRas->MultiplyPoint(farIndex, farRas);
+  std::copy(farRas, farRas + 3, corner);
+  const double radius = 1.6;
+  const double path[3][3] = { { corner[0] - 3.0, corner[1] - 2.0, corner[2] - 2.5 }, { corner[0] - 1.0, corner[1] - 0.5, corner[2] - 1.0 },
+    { corner[0] + 1.0, corner[1] + 0.5, corner[2] + 0.5 } };
+  CHECK_BOOL(field->CutCapsule(path[0], path[1], radius), true);
+  CHECK_BOOL(field->CutCapsule(path[1], path[2], radius), true);
+
+  vtkNew<vtkMatrix4x4> subToRas;
+  field->GetSubVoxelIJKToRAS(subToRas);
+  const int* subDims = field->GetDimensions();
+  const int* brickDims = field->GetBrickDimensions();
+  const double band = field->GetBandWidth();
+  vtkNew<vtkIdList> bricks;
+  field->GetBricksModifiedSince(0, bricks);
+  CHECK_BOOL(bricks->GetNumberOfIds() > 0, true);
+  bool reachedFarFace = false;
+  double worst = 0.0;
+  std::vector<short> values(vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize);
+  for (vtkIdType n = 0; n < bricks->GetNumberOfIds(); ++n)
+  {
+    const vtkIdType id = bricks->GetId(n);
+    const int b[3] = { static_cast<int>(id % brickDims[0]), static_cast<int>((id / brickDims[0]) % brickDims[1]),
+      static_cast<int>(id / (static_cast<vtkIdType>(brickDims[0]) * brickDims[1])) };
+    field->CopyBrick(id, values.data());
+    for (int local = 0; local < static_cast<int>(values.size()); ++local)
+    {
+      const int s[3] = { b[0] * 8 + local % 8, b[1] * 8 + (local / 8) % 8, b[2] * 8 + local / 64 };
+      if (s[0] >= subDims[0] || s[1] >= subDims[1] || s[2] >= subDims[2])
+      {
+        if (values[local] != std::numeric_limits<short>::max())
+        {
+          std::cerr << "sample " << s[0] << " " << s[1] << " " << s[2] << " past the volume was written" << std::endl;
+          return EXIT_FAILURE;
+        }
+        continue;
+      }
+      const double index[4] = { double(s[0]), double(s[1]), double(s[2]), 1.0 };
+      double ras[4];
+      subToRas->MultiplyPoint(index, ras);
+      double exact = band;
+      for (int segment = 0; segment < 2; ++segment)
+      {
+        double ab[3];
+        vtkMath::Subtract(path[segment + 1], path[segment], ab);
+        double w[3];
+        vtkMath::Subtract(ras, path[segment], w);
+        const double t = std::min(1.0, std::max(0.0, vtkMath::Dot(w, ab) / vtkMath::Dot(ab, ab)));
+        const double nearest[3] = { path[segment][0] + t * ab[0], path[segment][1] + t * ab[1], path[segment][2] + t * ab[2] };
+        exact = std::min(exact, std::sqrt(vtkMath::Distance2BetweenPoints(ras, nearest)) - radius);
+      }
+      exact = std::max(-band, exact);
+      worst = std::max(worst, std::abs(values[local] * field->GetQuantum() - exact));
+      reachedFarFace |= (s[0] == subDims[0] - 1 || s[1] == subDims[1] - 1 || s[2] == subDims[2] - 1) && exact < 0.0;
+    }
+  }
+  CHECK_BOOL(reachedFarFace, true);
+  if (worst > 1e-4)
+  {
+    std::cerr << "stored distances differ from the exact ones by up to " << worst << " mm" << std::endl;
+    return EXIT_FAILURE;
+  }
+  return EXIT_SUCCESS;
+}
 //------------------------------------------------------------------------------
 int TestRestoreUndoRedoAndStamps()
 {
@@ -423,6 +504,7 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestSphereAccuracy(true));
   CHECK_EXIT_SUCCESS(TestCapsuleAndStrokeEquivalence());
   CHECK_EXIT_SUCCESS(TestSegmentedPathAfterRestoreAndUndo());
+  CHECK_EXIT_SUCCESS(TestStoredDistancesAtTheFarFaces());
   CHECK_EXIT_SUCCESS(TestRestoreUndoRedoAndStamps());
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
