@@ -159,11 +159,30 @@ struct vtkVolumeCutField::ProtectionBrick
 };
 
 //------------------------------------------------------------------------------
+/// One stroke's bricks as they were before it (empty values: the brick did
+/// not exist, all Outside). The state after it is read back when the stroke
+/// is undone (until then the field holds it: every later change is a later
+/// step, undone first, or clears the history), so closing a stroke copies
+/// nothing; steps waiting to be redone hold both.
 struct vtkVolumeCutField::UndoStep
 {
-  std::vector<std::pair<vtkIdType, BrickValues>> Before;
-  std::vector<std::pair<vtkIdType, BrickValues>> After;
-  size_t MemorySize() const { return (this->Before.size() + this->After.size()) * (SamplesPerBrick * sizeof(int16_t) + 64); }
+  BrickStates Before;
+  BrickStates After;
+  size_t Memory = 0; // bytes held, kept by whoever changes Before or After
+
+  static size_t EntryMemory(const BrickValues& values) { return values.size() * sizeof(int16_t) + 64; }
+  size_t MemorySize() const { return this->Memory; }
+  void CountMemory()
+  {
+    this->Memory = 0;
+    for (const BrickStates* states : { &this->Before, &this->After })
+    {
+      for (const auto& entry : *states)
+      {
+        this->Memory += EntryMemory(entry.second);
+      }
+    }
+  }
 };
 
 //------------------------------------------------------------------------------
@@ -332,6 +351,7 @@ void vtkVolumeCutField::Reset()
   this->UndoMemorySize = 0;
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
+  this->StrokeBeforeMemory = 0;
   this->ProtectionBricks.clear();
   this->LastCapsule.Valid = false;
   this->ResetContact();
@@ -574,20 +594,24 @@ vtkVolumeCutField::Brick* vtkVolumeCutField::GetOrCreateBrick(vtkIdType brickId)
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick)
 {
-  // A brick that did not exist is remembered empty, expanded at EndStroke:
-  // a moving burr enters new bricks every few segments, and the haptic
-  // thread should not fill kilobytes of Outside for each.
+  // A brick that did not exist is remembered empty (all Outside): a moving
+  // burr enters new bricks every few segments, and the haptic thread should
+  // not fill kilobytes of Outside for each.
   const auto inserted = this->StrokeBefore.try_emplace(brickId);
-  if (!inserted.second || !brick)
+  if (!inserted.second)
   {
     return;
   }
   BrickValues& values = inserted.first->second;
-  values.resize(SamplesPerBrick);
-  for (int index = 0; index < SamplesPerBrick; ++index)
+  if (brick)
   {
-    values[index] = brick->Values[index].load(std::memory_order_relaxed);
+    values.resize(SamplesPerBrick);
+    for (int index = 0; index < SamplesPerBrick; ++index)
+    {
+      values[index] = brick->Values[index].load(std::memory_order_relaxed);
+    }
   }
+  this->StrokeBeforeMemory += UndoStep::EntryMemory(values);
 }
 
 //------------------------------------------------------------------------------
@@ -1260,6 +1284,7 @@ void vtkVolumeCutField::BeginStroke()
   }
   this->StrokeOpen = true;
   this->StrokeBefore.clear();
+  this->StrokeBeforeMemory = 0;
 }
 
 //------------------------------------------------------------------------------
@@ -1274,23 +1299,11 @@ void vtkVolumeCutField::EndStroke()
   {
     return;
   }
+  // Handed over whole, copying nothing: the haptic thread may close strokes.
   UndoStep step;
-  for (auto& entry : this->StrokeBefore)
-  {
-    const Brick* brick = this->Directory[entry.first].load(std::memory_order_relaxed);
-    BrickValues after(SamplesPerBrick, Outside);
-    for (int index = 0; brick && index < SamplesPerBrick; ++index)
-    {
-      after[index] = brick->Values[index].load(std::memory_order_relaxed);
-    }
-    if (entry.second.empty())
-    {
-      entry.second.assign(SamplesPerBrick, Outside); // the brick did not exist
-    }
-    step.Before.emplace_back(entry.first, std::move(entry.second));
-    step.After.emplace_back(entry.first, std::move(after));
-  }
-  this->StrokeBefore.clear();
+  step.Before.swap(this->StrokeBefore);
+  step.Memory = this->StrokeBeforeMemory;
+  this->StrokeBeforeMemory = 0;
   this->RedoStack.clear();
   this->PushUndoStep(std::move(step));
 }
@@ -1324,7 +1337,7 @@ void vtkVolumeCutField::PushUndoStep(UndoStep&& step)
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutField::WriteBricks(const std::vector<std::pair<vtkIdType, BrickValues>>& bricks)
+void vtkVolumeCutField::WriteBricks(const BrickStates& bricks)
 {
   for (const auto& entry : bricks)
   {
@@ -1332,9 +1345,10 @@ void vtkVolumeCutField::WriteBricks(const std::vector<std::pair<vtkIdType, Brick
     const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
     brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_release);
+    const bool absent = entry.second.empty(); // a brick remembered before it existed
     for (int index = 0; index < SamplesPerBrick; ++index)
     {
-      brick->Values[index].store(entry.second[index], std::memory_order_relaxed);
+      brick->Values[index].store(absent ? Outside : entry.second[index], std::memory_order_relaxed);
     }
     // One writer: the brick's stamp is published before the counter passes
     // it, so a reader that has seen the counter sees the brick as modified.
@@ -1358,6 +1372,15 @@ bool vtkVolumeCutField::Undo()
   UndoStep step = std::move(this->UndoStack.back());
   this->UndoStack.pop_back();
   this->UndoMemorySize -= step.MemorySize();
+  // The field holds the state after this step: keep it for a redo.
+  step.After.clear();
+  for (const auto& entry : step.Before)
+  {
+    BrickValues& after = step.After[entry.first];
+    after.resize(SamplesPerBrick);
+    this->CopyBrick(entry.first, after.data());
+  }
+  step.CountMemory();
   this->WriteBricks(step.Before);
   this->RedoStack.push_back(std::move(step));
   return true;
@@ -1375,6 +1398,8 @@ bool vtkVolumeCutField::Redo()
   UndoStep step = std::move(this->RedoStack.back());
   this->RedoStack.pop_back();
   this->WriteBricks(step.After);
+  step.After.clear(); // read back again by the next undo
+  step.CountMemory();
   this->UndoMemorySize += step.MemorySize();
   this->UndoStack.push_back(std::move(step));
   return true;
@@ -1848,8 +1873,7 @@ bool vtkVolumeCutField::ReadFile(const char* fileName)
     vtkErrorMacro("ReadFile: " << fileName << " is inconsistent (quantum or brick count)");
     return false;
   }
-  std::vector<std::pair<vtkIdType, BrickValues>> bricks;
-  bricks.reserve(static_cast<size_t>(count));
+  BrickStates bricks;
   for (int64_t n = 0; n < count; ++n)
   {
     int64_t brickId = -1;
@@ -1864,7 +1888,7 @@ bool vtkVolumeCutField::ReadFile(const char* fileName)
       vtkErrorMacro("ReadFile: " << fileName << " names a brick outside the volume");
       return false;
     }
-    bricks.emplace_back(static_cast<vtkIdType>(brickId), std::move(values));
+    bricks[static_cast<vtkIdType>(brickId)] = std::move(values);
   }
   loaded->WriteBricks(bricks);
   this->DeepCopy(loaded);
@@ -1893,14 +1917,14 @@ void vtkVolumeCutField::DeepCopy(vtkVolumeCutField* source)
   this->Initialize(dimensions, ijkToRas, f);
   this->MaximumStrokeLength = source->MaximumStrokeLength;
   this->UndoMemoryBudget = source->UndoMemoryBudget;
-  std::vector<std::pair<vtkIdType, BrickValues>> bricks;
+  BrickStates bricks;
   const vtkIdType count = source->GetNumberOfAllocatedBricks();
   short values[SamplesPerBrick];
   for (vtkIdType n = 0; n < count; ++n)
   {
     const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
     source->CopyBrick(brickId, values);
-    bricks.emplace_back(brickId, BrickValues(values, values + SamplesPerBrick));
+    bricks[brickId].assign(values, values + SamplesPerBrick);
   }
   this->WriteBricks(bricks);
 }

@@ -307,6 +307,8 @@ protected:
   };
 
   using BrickValues = std::vector<int16_t>;
+  /// Whole bricks' values by brick ID.
+  using BrickStates = std::map<vtkIdType, BrickValues>;
 
   /// Samples [Start, Start + Count) of a brick that a merge changed.
   struct ChangedRun
@@ -339,7 +341,7 @@ protected:
   Brick* GetOrCreateBrick(vtkIdType brickId);
   void RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick);
   void PushUndoStep(UndoStep&& step);
-  void WriteBricks(const std::vector<std::pair<vtkIdType, BrickValues>>& bricks);
+  void WriteBricks(const BrickStates& bricks);
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
   /// Calls visit(i, j, k) for every sample of every allocated brick.
@@ -398,7 +400,8 @@ protected:
   double BrickBoundingRadius = 0.0;
   bool StrokeOpen = false;
   // Bricks touched by the open stroke: their values before it began.
-  std::map<vtkIdType, BrickValues> StrokeBefore;
+  BrickStates StrokeBefore;
+  size_t StrokeBeforeMemory = 0;
   std::atomic<vtkTypeUInt64> StampCounter{ 0 };
   std::vector<UndoStep> UndoStack;
   std::vector<UndoStep> RedoStack;
