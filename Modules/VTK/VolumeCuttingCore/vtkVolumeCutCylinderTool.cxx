@@ -15,7 +15,11 @@ double vtkVolumeCutCylinderTool::EvaluateDistance(const double local[3])
   // Exact distance to a finite cylinder: a 2D box distance in (radial, axial).
   const double radial = std::sqrt(local[0] * local[0] + local[1] * local[1]) - this->Radius;
   const double axial = std::abs(local[2]) - 0.5 * this->Length;
-  const double outside = std::hypot(std::max(radial, 0.0), std::max(axial, 0.0));
+  // sqrt, not hypot: these are millimetres, far from overflow, and a sweep
+  // evaluates this hundreds of thousands of times a stroke.
+  const double outsideRadial = std::max(radial, 0.0);
+  const double outsideAxial = std::max(axial, 0.0);
+  const double outside = std::sqrt(outsideRadial * outsideRadial + outsideAxial * outsideAxial);
   return outside + std::min(std::max(radial, axial), 0.0);
 }
 

@@ -55,7 +55,10 @@ double vtkVolumeCutPrismTool::EvaluateDistance(const double local[3])
   const double planar = inside ? -std::sqrt(nearest2) : std::sqrt(nearest2);
   // Combine with the slab 0 <= z <= Depth as for a box: exact for a prism.
   const double axial = std::abs(local[2] - 0.5 * this->Depth) - 0.5 * this->Depth;
-  const double outside = std::hypot(std::max(planar, 0.0), std::max(axial, 0.0));
+  // sqrt, not hypot: millimetres, far from overflow, and evaluated per sample.
+  const double outsidePlanar = std::max(planar, 0.0);
+  const double outsideAxial = std::max(axial, 0.0);
+  const double outside = std::sqrt(outsidePlanar * outsidePlanar + outsideAxial * outsideAxial);
   return outside + std::min(std::max(planar, axial), 0.0);
 }
 
