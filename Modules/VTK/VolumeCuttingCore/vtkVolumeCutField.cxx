@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutFieldDistanceSource.h"
+#include "vtkVolumeCutVectorClones.h"
 
 #include "vtkDataArray.h"
 #include "vtkFlyingEdges3D.h"
@@ -56,21 +57,6 @@ void Transform(const double m[4][4], const double in[3], double out[3])
   }
 }
 
-// The writer's inner loops run once per brick sample of every stroke: they
-// are built for AVX-512 and AVX2 besides the baseline, and the loader picks
-// what the processor has (GCC on Linux; elsewhere the baseline). The file is
-// compiled without floating-point contraction, so every variant rounds alike
-// and replays stay bitwise reproducible across machines.
-// Defining VOLUMECUTTING_VECTOR_CLONES empty builds the baseline alone, as
-// ThreadSanitizer needs (its runtime is not up when the loader picks).
-#ifndef VOLUMECUTTING_VECTOR_CLONES
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) && !defined(__SANITIZE_THREAD__)
-#define VOLUMECUTTING_VECTOR_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define VOLUMECUTTING_VECTOR_CLONES
-#endif
-#endif
-
 /// Distances (mm, negative inside) of a brick's samples at w0 + offsets from
 /// the capsule of segment ab (from the origin) and radius; samples with
 /// (w . ab) / |ab|^2 below behindLimit are given far instead.
@@ -92,6 +78,44 @@ void CapsuleBrickDistances(const float w0[3], const float ab[3], float inverseLe
     const float dz = wz - along * ab[2];
     const float distance = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
     distances[n] = ahead < behindLimit ? far : distance;
+  }
+}
+
+/// A brick's samples (origin + offsets) in the frame of a tool at pose
+/// (tool-to-RAS rotation and translation): x, y and z runs.
+VOLUMECUTTING_VECTOR_CLONES
+void ToToolFrameKernel(const float rotation[3][3], const float w0[3], const float* __restrict offsets, float* __restrict x, float* __restrict y,
+  float* __restrict z)
+{
+  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
+  // Locals: the stores below cannot then be taken to change them.
+  const float r00 = rotation[0][0], r01 = rotation[0][1], r02 = rotation[0][2];
+  const float r10 = rotation[1][0], r11 = rotation[1][1], r12 = rotation[1][2];
+  const float r20 = rotation[2][0], r21 = rotation[2][1], r22 = rotation[2][2];
+  const float w0x = w0[0], w0y = w0[1], w0z = w0[2];
+  for (int n = 0; n < samples; ++n)
+  {
+    const float wx = w0x + offsets[n];
+    const float wy = w0y + offsets[samples + n];
+    const float wz = w0z + offsets[2 * samples + n];
+    x[n] = r00 * wx + r10 * wy + r20 * wz;
+    y[n] = r01 * wx + r11 * wy + r21 * wz;
+    z[n] = r02 * wx + r12 * wy + r22 * wz;
+  }
+}
+
+/// distances = min(distances, copy) where the sample is within reach of the
+/// copy's centre (farther, a tool's distance may underestimate).
+VOLUMECUTTING_VECTOR_CLONES
+void MergeCopy(const float* __restrict x, const float* __restrict y, const float* __restrict z, const float* __restrict copy, float reach2,
+  float* __restrict distances)
+{
+  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
+  for (int n = 0; n < samples; ++n)
+  {
+    const float centre2 = x[n] * x[n] + y[n] * y[n] + z[n] * z[n];
+    const float candidate = centre2 <= reach2 ? copy[n] : distances[n];
+    distances[n] = candidate < distances[n] ? candidate : distances[n];
   }
 }
 
@@ -660,7 +684,7 @@ public:
     }
     return true;
   }
-  void BrickDistances(const double origin[3], const float* offsets, float* distances) const override
+  void BrickDistances(const double origin[3], const double* /*center*/, double /*radius*/, const float* offsets, float* distances) const override
   {
     const float w0[3] = { static_cast<float>(origin[0] - this->P0[0]), static_cast<float>(origin[1] - this->P0[1]),
       static_cast<float>(origin[2] - this->P0[2]) };
@@ -692,17 +716,35 @@ struct RigidPose
   double Translation[3];
 };
 
+/// A brick's samples (origin + offsets) in the frame of the tool at pose.
+void ToToolFrame(const RigidPose& pose, const double origin[3], const float* offsets,
+  float local[3][vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize])
+{
+  float rotation[3][3];
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      rotation[row][column] = static_cast<float>(pose.Rotation[row][column]);
+    }
+  }
+  const float w0[3] = { static_cast<float>(origin[0] - pose.Translation[0]), static_cast<float>(origin[1] - pose.Translation[1]),
+    static_cast<float>(origin[2] - pose.Translation[2]) };
+  ToToolFrameKernel(rotation, w0, offsets, local[0], local[1], local[2]);
+}
+
 /// The sweep of any tool: the tool at poses close enough that the union of
-/// its copies covers the continuous sweep to within half a sub-voxel.
-class SweptToolSource : public vtkVolumeCutField::RowDistanceSource
+/// its copies covers the continuous sweep to within half a sub-voxel. Written
+/// a brick at a time: each copy whose reach sphere meets a brick is evaluated
+/// at all its samples in one batch (vtkVolumeCutTool::EvaluateDistances).
+class SweptToolSource : public vtkVolumeCutField::BrickDistanceSource
 {
 public:
-  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach, const double rowStep[3])
+  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach)
     : Tool(tool)
     , Poses(std::move(poses))
     , Reach(reach)
   {
-    std::copy(rowStep, rowStep + 3, this->Step);
   }
   void GetReachBounds(double lower[3], double upper[3]) const override
   {
@@ -717,32 +759,34 @@ public:
       }
     }
   }
-  bool RowInterval(const double origin[3], double& first, double& last) const override
+  bool MayReach(const double center[3], double radius) const override
   {
-    first = std::numeric_limits<double>::max();
-    last = -std::numeric_limits<double>::max();
-    const double a = this->Step[0] * this->Step[0] + this->Step[1] * this->Step[1] + this->Step[2] * this->Step[2];
     for (const RigidPose& pose : this->Poses)
     {
-      const double w[3] = { origin[0] - pose.Translation[0], origin[1] - pose.Translation[1], origin[2] - pose.Translation[2] };
-      const double b = 2.0 * (w[0] * this->Step[0] + w[1] * this->Step[1] + w[2] * this->Step[2]);
-      const double c = w[0] * w[0] + w[1] * w[1] + w[2] * w[2] - this->Reach * this->Reach;
-      const double discriminant = b * b - 4.0 * a * c;
-      if (discriminant >= 0.0)
+      if (this->Meets(pose, center, radius))
       {
-        const double root = std::sqrt(discriminant);
-        first = std::min(first, (-b - root) / (2.0 * a));
-        last = std::max(last, (-b + root) / (2.0 * a));
+        return true;
       }
     }
-    return first <= last;
+    return false;
   }
-  void RowDistances(const double origin[3], int first, int last, float* distances) const override
+  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override
   {
-    for (int i = first; i <= last; ++i)
+    constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
+    // Beyond the band: clamped to Outside, so a copy out of reach changes nothing.
+    const float far = static_cast<float>(this->Reach);
+    std::fill(distances, distances + samples, far);
+    float local[3][samples];
+    float copy[samples];
+    for (const RigidPose& pose : this->Poses)
     {
-      const double point[3] = { origin[0] + i * this->Step[0], origin[1] + i * this->Step[1], origin[2] + i * this->Step[2] };
-      distances[i - first] = static_cast<float>(this->Distance(point));
+      if (!this->Meets(pose, center, radius))
+      {
+        continue;
+      }
+      ToToolFrame(pose, origin, offsets, local);
+      this->Tool->EvaluateDistances(local[0], local[1], local[2], samples, copy);
+      MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
     }
   }
   double Distance(const double point[3]) const override
@@ -767,9 +811,16 @@ public:
   }
 
 private:
+  /// Whether the copy of the tool at pose reaches into the ball.
+  bool Meets(const RigidPose& pose, const double center[3], double radius) const
+  {
+    const double w[3] = { center[0] - pose.Translation[0], center[1] - pose.Translation[1], center[2] - pose.Translation[2] };
+    const double limit = this->Reach + radius;
+    return w[0] * w[0] + w[1] * w[1] + w[2] * w[2] <= limit * limit;
+  }
+
   vtkVolumeCutTool* Tool;
   std::vector<RigidPose> Poses;
-  double Step[3];
   double Reach;
 };
 
@@ -904,8 +955,7 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
       poses[n].Translation[axis] = (1.0 - t) * start.Translation[axis] + t * end.Translation[axis];
     }
   }
-  const double rowStep[3] = { this->SubIJKToRAS[0][0], this->SubIJKToRAS[1][0], this->SubIJKToRAS[2][0] };
-  const SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth, rowStep);
+  const SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
   this->ApplyDistance(source, operation);
   return true;
 }
@@ -1225,7 +1275,7 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
         }
         double origin[3];
         Transform(this->SubIJKToRAS, firstSample, origin);
-        source.BrickDistances(origin, this->BrickSampleOffsets.data(), distances);
+        source.BrickDistances(origin, center, this->BrickBoundingRadius, this->BrickSampleOffsets.data(), distances);
         this->QuantizeDistances(distances, SamplesPerBrick, operation, quantized);
 
         // Samples past the volume's far faces exist in the brick, not in the field.

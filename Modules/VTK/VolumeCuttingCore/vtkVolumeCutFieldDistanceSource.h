@@ -37,8 +37,8 @@ struct vtkVolumeCutField::BrickDistanceSource : vtkVolumeCutField::DistanceSourc
   /// False when no point within radius of center is within reach.
   virtual bool MayReach(const double center[3], double radius) const = 0;
   /// Distances at origin + offsets, the field's brick sample offsets (x, y
-  /// and z runs of BrickSize^3 each).
-  virtual void BrickDistances(const double origin[3], const float* offsets, float* distances) const = 0;
+  /// and z runs of BrickSize^3 each); the samples lie within radius of center.
+  virtual void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const = 0;
 };
 
 #endif

@@ -7,3 +7,13 @@ void vtkVolumeCutTool::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
 }
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutTool::EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances)
+{
+  for (int n = 0; n < count; ++n)
+  {
+    const double local[3] = { x[n], y[n], z[n] };
+    distances[n] = static_cast<float>(this->EvaluateDistance(local));
+  }
+}

@@ -17,6 +17,7 @@
 #define vtkVolumeCutTool_h
 
 #include "vtkObject.h"
+#include "vtkWrappingHints.h" // For VTK_WRAPEXCLUDE
 #include "vtkVolumeCuttingCoreExport.h" // For export macro
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutTool : public vtkObject
@@ -29,6 +30,12 @@ public:
   /// negative inside. It must be exact near the surface (within the cut
   /// field's band) and may underestimate farther away.
   virtual double EvaluateDistance(const double local[3]) = 0;
+
+  /// EvaluateDistance at count points given as coordinate runs (the cut
+  /// field's writer evaluates whole bricks, in single precision). The default
+  /// calls EvaluateDistance for each; shapes with a closed form override it
+  /// with a loop that vectorises.
+  VTK_WRAPEXCLUDE virtual void EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances);
 
   /// Radius (mm) of a sphere about the local origin that holds the tool.
   virtual double GetBoundingRadius() = 0;
