@@ -172,6 +172,20 @@ struct vtkVolumeCutField::Brick
   /// other threads only read, so the writer's own plain reads race with
   /// nothing (lock-free 16-bit atomics have the layout of the integer).
   const int16_t* WriterView() const { return reinterpret_cast<const int16_t*>(this->Values); }
+
+  /// The writer's own record that every sample is Inside: no cut can change
+  /// the brick then (Inside is the least value), so strokes skip it.
+  bool AllInside = false;
+  void UpdateAllInside()
+  {
+    const int16_t* values = this->WriterView();
+    int differing = 0;
+    for (int index = 0; index < SamplesPerBrick; ++index)
+    {
+      differing |= values[index] != Inside;
+    }
+    this->AllInside = differing == 0;
+  }
 };
 static_assert(sizeof(std::atomic<int16_t>) == sizeof(int16_t), "16-bit atomics must have the layout of the integer");
 
@@ -1152,6 +1166,7 @@ void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16
   brick->Stamp.store(stamp, std::memory_order_release);
   this->StampCounter.store(stamp, std::memory_order_release);
   brick->Sequence.store(sequence + 2, std::memory_order_release);
+  brick->UpdateAllInside();
 }
 
 //------------------------------------------------------------------------------
@@ -1262,6 +1277,10 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
         if (!brick && operation == Operation::Restore)
         {
           continue; // nothing removed here, nothing to put back
+        }
+        if (brick && brick->AllInside && operation == Operation::Cut)
+        {
+          continue; // removed through and through already
         }
         const int brickIndex[3] = { bi, bj, bk };
         const double firstSample[3] = { double(bi * BrickSize), double(bj * BrickSize), double(bk * BrickSize) };
@@ -1406,6 +1425,7 @@ void vtkVolumeCutField::WriteBricks(const BrickStates& bricks)
     brick->Stamp.store(stamp, std::memory_order_release);
     this->StampCounter.store(stamp, std::memory_order_release);
     brick->Sequence.store(sequence + 2, std::memory_order_release);
+    brick->UpdateAllInside();
   }
   this->Modified();
 }
