@@ -300,6 +300,38 @@ int TestStoredDistancesAtTheFarFaces()
   }
   return EXIT_SUCCESS;
 }
+
+// Cuts skip bricks removed through and through, until a restore or an undo
+// puts material back into them.
+int TestFullyRemovedBricksReopen()
+{
+  const int dims[3] = { 48, 48, 48 };
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  MakeGrid(ijkToRas);
+  vtkNew<vtkVolumeCutField> field;
+  field->Initialize(dims, ijkToRas, 2);
+  const double center[3] = { 12.1, 12.3, 11.8 };
+  CHECK_BOOL(field->CutCapsule(center, center, 5.0), true); // bricks at the centre are Inside throughout
+  const double ball = field->ComputeRemovedVolume();
+  CHECK_BOOL(field->RestoreCapsule(center, center, 2.0), true);
+  CHECK_BOOL(field->GetSignedDistance(center) > 0.0, true);
+  CHECK_BOOL(field->CutCapsule(center, center, 2.0), true);
+  // Cut again, the ball is whole but for a seam of zero thickness where the
+  // restore's surface was (the field touches 0 there without crossing it),
+  // which the volume estimate counts as a sliver: 0.06 % here.
+  CHECK_DOUBLE_TOLERANCE(field->ComputeRemovedVolume(), ball, 1e-3 * ball);
+  CHECK_BOOL(field->GetSignedDistance(center) < 0.0, true);
+  // Undo every step: the field is empty again, and a cut must cut.
+  while (field->GetNumberOfUndoSteps() > 0)
+  {
+    CHECK_BOOL(field->Undo(), true);
+  }
+  CHECK_DOUBLE_TOLERANCE(field->ComputeRemovedVolume(), 0.0, 1e-12);
+  CHECK_BOOL(field->CutCapsule(center, center, 2.0), true);
+  CHECK_BOOL(field->GetSignedDistance(center) < 0.0, true);
+  CHECK_DOUBLE_TOLERANCE(field->ComputeRemovedVolume(), 4.0 / 3.0 * Pi * 8.0, 0.005 * 4.0 / 3.0 * Pi * 8.0);
+  return EXIT_SUCCESS;
+}
 //------------------------------------------------------------------------------
 int TestRestoreUndoRedoAndStamps()
 {
@@ -518,6 +550,7 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestCapsuleAndStrokeEquivalence());
   CHECK_EXIT_SUCCESS(TestSegmentedPathAfterRestoreAndUndo());
   CHECK_EXIT_SUCCESS(TestStoredDistancesAtTheFarFaces());
+  CHECK_EXIT_SUCCESS(TestFullyRemovedBricksReopen());
   CHECK_EXIT_SUCCESS(TestRestoreUndoRedoAndStamps());
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
