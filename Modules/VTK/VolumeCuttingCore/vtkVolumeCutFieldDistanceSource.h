@@ -19,8 +19,9 @@ struct vtkVolumeCutField::DistanceSource
   virtual double Distance(const double point[3]) const = 0;
 };
 
-/// A sweep written row by row: for tools whose distance is costly, where the
-/// exact stretch of each grid row within reach saves most evaluations.
+/// A sweep written row by row, within the exact stretch of each grid row in
+/// reach: for sources whose work per sample is costly and tied to the voxel
+/// (material removal looks up each brick's exposure), not to the brick.
 struct vtkVolumeCutField::RowDistanceSource : vtkVolumeCutField::DistanceSource
 {
   /// Stretch [first, last] (row index units) of the row origin + t * step within reach.
