@@ -4,14 +4,18 @@
 #-----------------------------------------------------------------------------
 # volumecutting_add_library(<kit>
 #   VTK_MODULE <name in vtk.module> EXPORT_DIRECTIVE <macro> SRCS <files...>
-#   [INCLUDE_DIRECTORIES <dirs...>] [TARGET_LIBRARIES <libs...>])
+#   [PRIVATE_SRCS <files...>] [INCLUDE_DIRECTORIES <dirs...>]
+#   [TARGET_LIBRARIES <libs...>])
+#
+# SRCS are classes (<class>.cxx with <class>.h), installed and wrapped.
+# PRIVATE_SRCS are compiled into the library only: no class, not wrapped.
 #
 # Every library exposes <kit>Export.h defining <EXPORT_DIRECTIVE>, as Slicer's
 # macros generate it; in Core mode the header forwards to the VTK module's.
 # TARGET_LIBRARIES are used in extension mode only: in Core mode the
 # dependencies come from vtk.module.
 function(volumecutting_add_library kit)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "" "VTK_MODULE;EXPORT_DIRECTIVE" "SRCS;INCLUDE_DIRECTORIES;TARGET_LIBRARIES")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "VTK_MODULE;EXPORT_DIRECTIVE" "SRCS;PRIVATE_SRCS;INCLUDE_DIRECTORIES;TARGET_LIBRARIES")
   if(VolumeCutting_BUILD_WITH_SLICER_CORE)
     set(classes)
     foreach(source IN LISTS arg_SRCS)
@@ -21,17 +25,25 @@ function(volumecutting_add_library kit)
     endforeach()
     string(REGEX REPLACE "_EXPORT$" "" export_prefix "${arg_EXPORT_DIRECTIVE}")
     slicercore_generate_module_wrapper(HEADER_NAME ${kit}Export.h OUTPUT_VAR export_header)
+    set(private_headers ${arg_PRIVATE_SRCS})
+    list(FILTER private_headers INCLUDE REGEX "\\.h$")
+    set(private_sources ${arg_PRIVATE_SRCS})
+    list(FILTER private_sources EXCLUDE REGEX "\\.h$")
     vtk_module_add_module(${arg_VTK_MODULE}
       EXPORT_MACRO_PREFIX ${export_prefix}
       CLASSES ${classes}
       HEADERS ${export_header}
+      SOURCES ${private_sources}
+      PRIVATE_HEADERS ${private_headers}
       )
   else()
+    # Slicer's wrapping takes every <name>.cxx that has a <name>.h.
+    set_source_files_properties(${arg_PRIVATE_SRCS} PROPERTIES WRAP_EXCLUDE ON)
     SlicerMacroBuildModuleLogic(
       NAME ${kit}
       EXPORT_DIRECTIVE ${arg_EXPORT_DIRECTIVE}
       INCLUDE_DIRECTORIES ${arg_INCLUDE_DIRECTORIES}
-      SRCS ${arg_SRCS}
+      SRCS ${arg_SRCS} ${arg_PRIVATE_SRCS}
       TARGET_LIBRARIES ${arg_TARGET_LIBRARIES}
       )
   endif()

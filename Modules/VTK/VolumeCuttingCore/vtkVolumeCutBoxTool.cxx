@@ -1,7 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutBoxTool.h"
-#include "vtkVolumeCutVectorClones.h"
+#include "vtkVolumeCutKernels.h"
 
 #include "vtkObjectFactory.h"
 
@@ -27,31 +27,10 @@ double vtkVolumeCutBoxTool::EvaluateDistance(const double local[3])
 }
 
 //------------------------------------------------------------------------------
-namespace
-{
-VOLUMECUTTING_VECTOR_CLONES
-void BoxDistances(const float half[3], const float* x, const float* y, const float* z, int count, float* distances)
-{
-  for (int n = 0; n < count; ++n)
-  {
-    const float ex = std::abs(x[n]) - half[0];
-    const float ey = std::abs(y[n]) - half[1];
-    const float ez = std::abs(z[n]) - half[2];
-    const float ox = ex > 0.0f ? ex : 0.0f;
-    const float oy = ey > 0.0f ? ey : 0.0f;
-    const float oz = ez > 0.0f ? ez : 0.0f;
-    float largest = ex > ey ? ex : ey;
-    largest = largest > ez ? largest : ez;
-    distances[n] = std::sqrt(ox * ox + oy * oy + oz * oz) + (largest < 0.0f ? largest : 0.0f);
-  }
-}
-}
-
-//------------------------------------------------------------------------------
 void vtkVolumeCutBoxTool::EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances)
 {
   const float half[3] = { static_cast<float>(0.5 * this->Size[0]), static_cast<float>(0.5 * this->Size[1]), static_cast<float>(0.5 * this->Size[2]) };
-  BoxDistances(half, x, y, z, count, distances);
+  vtkVolumeCutKernels::Get().BoxDistances(half, x, y, z, count, distances);
 }
 
 //------------------------------------------------------------------------------

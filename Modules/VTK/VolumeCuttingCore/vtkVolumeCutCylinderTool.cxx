@@ -1,7 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutCylinderTool.h"
-#include "vtkVolumeCutVectorClones.h"
+#include "vtkVolumeCutKernels.h"
 
 #include "vtkObjectFactory.h"
 
@@ -25,27 +25,9 @@ double vtkVolumeCutCylinderTool::EvaluateDistance(const double local[3])
 }
 
 //------------------------------------------------------------------------------
-namespace
-{
-VOLUMECUTTING_VECTOR_CLONES
-void CylinderDistances(float radius, float halfLength, const float* x, const float* y, const float* z, int count, float* distances)
-{
-  for (int n = 0; n < count; ++n)
-  {
-    const float radial = std::sqrt(x[n] * x[n] + y[n] * y[n]) - radius;
-    const float axial = std::abs(z[n]) - halfLength;
-    const float outsideRadial = radial > 0.0f ? radial : 0.0f;
-    const float outsideAxial = axial > 0.0f ? axial : 0.0f;
-    const float larger = radial > axial ? radial : axial;
-    distances[n] = std::sqrt(outsideRadial * outsideRadial + outsideAxial * outsideAxial) + (larger < 0.0f ? larger : 0.0f);
-  }
-}
-}
-
-//------------------------------------------------------------------------------
 void vtkVolumeCutCylinderTool::EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances)
 {
-  CylinderDistances(static_cast<float>(this->Radius), static_cast<float>(0.5 * this->Length), x, y, z, count, distances);
+  vtkVolumeCutKernels::Get().CylinderDistances(static_cast<float>(this->Radius), static_cast<float>(0.5 * this->Length), x, y, z, count, distances);
 }
 
 //------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutEllipsoidTool.h"
-#include "vtkVolumeCutVectorClones.h"
+#include "vtkVolumeCutKernels.h"
 
 #include "vtkObjectFactory.h"
 
@@ -32,29 +32,6 @@ double vtkVolumeCutEllipsoidTool::EvaluateDistance(const double local[3])
 }
 
 //------------------------------------------------------------------------------
-namespace
-{
-VOLUMECUTTING_VECTOR_CLONES
-void EllipsoidDistances(const float inverse[3], const float inverse2[3], float centre, const float* x, const float* y, const float* z, int count,
-  float* distances)
-{
-  for (int n = 0; n < count; ++n)
-  {
-    const float sx = x[n] * inverse[0];
-    const float sy = y[n] * inverse[1];
-    const float sz = z[n] * inverse[2];
-    const float tx = x[n] * inverse2[0];
-    const float ty = y[n] * inverse2[1];
-    const float tz = z[n] * inverse2[2];
-    const float k0 = std::sqrt(sx * sx + sy * sy + sz * sz);
-    const float k1 = std::sqrt(tx * tx + ty * ty + tz * tz);
-    const float safe = k1 > 0.0f ? k1 : 1.0f;
-    distances[n] = k1 > 0.0f ? k0 * (k0 - 1.0f) / safe : centre;
-  }
-}
-}
-
-//------------------------------------------------------------------------------
 void vtkVolumeCutEllipsoidTool::EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances)
 {
   float inverse[3];
@@ -64,7 +41,7 @@ void vtkVolumeCutEllipsoidTool::EvaluateDistances(const float* x, const float* y
     inverse[axis] = static_cast<float>(1.0 / this->Radii[axis]);
     inverse2[axis] = static_cast<float>(1.0 / (this->Radii[axis] * this->Radii[axis]));
   }
-  EllipsoidDistances(inverse, inverse2, static_cast<float>(-std::min({ this->Radii[0], this->Radii[1], this->Radii[2] })), x, y, z, count, distances);
+  vtkVolumeCutKernels::Get().EllipsoidDistances(inverse, inverse2, static_cast<float>(-std::min({ this->Radii[0], this->Radii[1], this->Radii[2] })), x, y, z, count, distances);
 }
 
 //------------------------------------------------------------------------------

@@ -2,7 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutFieldDistanceSource.h"
-#include "vtkVolumeCutVectorClones.h"
+#include "vtkVolumeCutKernels.h"
 
 #include "vtkDataArray.h"
 #include "vtkFlyingEdges3D.h"
@@ -32,8 +32,12 @@ namespace
 {
 constexpr int BrickSize = vtkVolumeCutField::BrickSize;
 constexpr int SamplesPerBrick = BrickSize * BrickSize * BrickSize;
-constexpr int16_t Outside = std::numeric_limits<int16_t>::max();
-constexpr int16_t Inside = -Outside;
+constexpr int16_t Outside = vtkVolumeCutKernels::Outside;
+constexpr int16_t Inside = vtkVolumeCutKernels::Inside;
+static_assert(Outside == std::numeric_limits<int16_t>::max() && Inside == -Outside, "the band spans the 16-bit range");
+static_assert(SamplesPerBrick == vtkVolumeCutKernels::SamplesPerBrick, "kernels work on whole bricks");
+static_assert(int(vtkVolumeCutField::InstructionSetAVX2) == int(vtkVolumeCutKernels::AVX2) && int(vtkVolumeCutField::InstructionSetAVX512) == int(vtkVolumeCutKernels::AVX512),
+  "one numbering of the instruction sets");
 
 double DistanceToSegment(const double p[3], const double a[3], const double ab[3], double abLength2)
 {
@@ -56,99 +60,6 @@ void Transform(const double m[4][4], const double in[3], double out[3])
     out[row] = m[row][0] * in[0] + m[row][1] * in[1] + m[row][2] * in[2] + m[row][3];
   }
 }
-
-/// Distances (mm, negative inside) of a brick's samples at w0 + offsets from
-/// the capsule of segment ab (from the origin) and radius; samples with
-/// (w . ab) / |ab|^2 below behindLimit are given far instead.
-VOLUMECUTTING_VECTOR_CLONES
-void CapsuleBrickDistances(const float w0[3], const float ab[3], float inverseLength2, float radius, float behindLimit, float far,
-  const float* offsets, float* distances)
-{
-  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
-  for (int n = 0; n < samples; ++n)
-  {
-    const float wx = w0[0] + offsets[n];
-    const float wy = w0[1] + offsets[samples + n];
-    const float wz = w0[2] + offsets[2 * samples + n];
-    const float ahead = (wx * ab[0] + wy * ab[1] + wz * ab[2]) * inverseLength2;
-    float along = ahead < 0.0f ? 0.0f : ahead;
-    along = along > 1.0f ? 1.0f : along;
-    const float dx = wx - along * ab[0];
-    const float dy = wy - along * ab[1];
-    const float dz = wz - along * ab[2];
-    const float distance = std::sqrt(dx * dx + dy * dy + dz * dz) - radius;
-    distances[n] = ahead < behindLimit ? far : distance;
-  }
-}
-
-/// A brick's samples (origin + offsets) in the frame of a tool at pose
-/// (tool-to-RAS rotation and translation): x, y and z runs.
-VOLUMECUTTING_VECTOR_CLONES
-void ToToolFrameKernel(const float rotation[3][3], const float w0[3], const float* __restrict offsets, float* __restrict x, float* __restrict y,
-  float* __restrict z)
-{
-  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
-  // Locals: the stores below cannot then be taken to change them.
-  const float r00 = rotation[0][0], r01 = rotation[0][1], r02 = rotation[0][2];
-  const float r10 = rotation[1][0], r11 = rotation[1][1], r12 = rotation[1][2];
-  const float r20 = rotation[2][0], r21 = rotation[2][1], r22 = rotation[2][2];
-  const float w0x = w0[0], w0y = w0[1], w0z = w0[2];
-  for (int n = 0; n < samples; ++n)
-  {
-    const float wx = w0x + offsets[n];
-    const float wy = w0y + offsets[samples + n];
-    const float wz = w0z + offsets[2 * samples + n];
-    x[n] = r00 * wx + r10 * wy + r20 * wz;
-    y[n] = r01 * wx + r11 * wy + r21 * wz;
-    z[n] = r02 * wx + r12 * wy + r22 * wz;
-  }
-}
-
-/// distances = min(distances, copy) where the sample is within reach of the
-/// copy's centre (farther, a tool's distance may underestimate).
-VOLUMECUTTING_VECTOR_CLONES
-void MergeCopy(const float* __restrict x, const float* __restrict y, const float* __restrict z, const float* __restrict copy, float reach2,
-  float* __restrict distances)
-{
-  constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
-  for (int n = 0; n < samples; ++n)
-  {
-    const float centre2 = x[n] * x[n] + y[n] * y[n] + z[n] * z[n];
-    const float candidate = centre2 <= reach2 ? copy[n] : distances[n];
-    distances[n] = candidate < distances[n] ? candidate : distances[n];
-  }
-}
-
-/// Distances to 16-bit samples: scaled, clamped to the band, rounded.
-VOLUMECUTTING_VECTOR_CLONES
-void QuantizeRun(const float* distances, int count, float scale, int16_t* quantized)
-{
-  const float insideF = static_cast<float>(Inside);
-  const float outsideF = static_cast<float>(Outside);
-  for (int n = 0; n < count; ++n)
-  {
-    float scaled = distances[n] * scale;
-    scaled = scaled < insideF ? insideF : scaled;
-    scaled = scaled > outsideF ? outsideF : scaled;
-    // Round to nearest through truncation of a positive number.
-    quantized[n] = static_cast<int16_t>(static_cast<int>(scaled + 32768.5f) - 32768);
-  }
-}
-
-/// merged = min(current, quantized); whether any sample changed.
-VOLUMECUTTING_VECTOR_CLONES
-bool MinimumRun(const int16_t* quantized, const int16_t* current, int count, int16_t* merged)
-{
-  int changed = 0;
-  for (int n = 0; n < count; ++n)
-  {
-    merged[n] = quantized[n] < current[n] ? quantized[n] : current[n];
-    changed |= merged[n] != current[n];
-  }
-  return changed != 0;
-}
-
-
 } // namespace
 
 //------------------------------------------------------------------------------
@@ -707,7 +618,7 @@ public:
     // Behind the start of a continued path the field holds the ball already:
     // far away there means unchanged.
     const float behindLimit = this->StartCovered && this->AbLength2 > 0.0 ? 0.0f : -std::numeric_limits<float>::infinity();
-    CapsuleBrickDistances(w0, ab, inverseLength2, static_cast<float>(this->Radius), behindLimit, static_cast<float>(2.0 * this->Reach), offsets, distances);
+    vtkVolumeCutKernels::Get().CapsuleBrickDistances(w0, ab, inverseLength2, static_cast<float>(this->Radius), behindLimit, static_cast<float>(2.0 * this->Reach), offsets, distances);
   }
 
 private:
@@ -744,7 +655,7 @@ void ToToolFrame(const RigidPose& pose, const double origin[3], const float* off
   }
   const float w0[3] = { static_cast<float>(origin[0] - pose.Translation[0]), static_cast<float>(origin[1] - pose.Translation[1]),
     static_cast<float>(origin[2] - pose.Translation[2]) };
-  ToToolFrameKernel(rotation, w0, offsets, local[0], local[1], local[2]);
+  vtkVolumeCutKernels::Get().ToToolFrame(rotation, w0, offsets, local[0], local[1], local[2]);
 }
 
 /// The sweep of any tool: the tool at poses close enough that the union of
@@ -800,7 +711,7 @@ public:
       }
       ToToolFrame(pose, origin, offsets, local);
       this->Tool->EvaluateDistances(local[0], local[1], local[2], samples, copy);
-      MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
+      vtkVolumeCutKernels::Get().MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
     }
   }
   double Distance(const double point[3]) const override
@@ -1075,7 +986,7 @@ void vtkVolumeCutField::ApplyDistance(const BrickDistanceSource& source, Operati
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::QuantizeDistances(const float* distances, int count, Operation operation, int16_t* quantized) const
 {
-  QuantizeRun(distances, count, static_cast<float>((operation == Operation::Cut ? 1.0 : -1.0) / this->Quantum), quantized);
+  vtkVolumeCutKernels::Get().QuantizeRun(distances, count, static_cast<float>((operation == Operation::Cut ? 1.0 : -1.0) / this->Quantum), quantized);
 }
 
 //------------------------------------------------------------------------------
@@ -1090,7 +1001,7 @@ bool vtkVolumeCutField::MergeSegment(const Brick* brick, const ProtectionBrick* 
   {
     if (current)
     {
-      return MinimumRun(quantized, current, count, merged);
+      return vtkVolumeCutKernels::Get().MinimumRun(quantized, current, count, merged);
     }
     else
     {
@@ -1748,6 +1659,30 @@ size_t vtkVolumeCutField::GetDenseMemorySize() const
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutField::SetInstructionSet(int set)
+{
+  return vtkVolumeCutKernels::Select(set);
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutField::GetInstructionSet()
+{
+  return vtkVolumeCutKernels::GetSelected();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::IsInstructionSetAvailable(int set)
+{
+  return vtkVolumeCutKernels::IsAvailable(set);
+}
+
+//------------------------------------------------------------------------------
+const char* vtkVolumeCutField::GetInstructionSetAsString(int set)
+{
+  return vtkVolumeCutKernels::GetName(set);
+}
+
+//------------------------------------------------------------------------------
 void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
@@ -1756,6 +1691,7 @@ void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BandWidth: " << this->BandWidth << "\n";
   os << indent << "CorrectionReach: " << this->CorrectionReach << "\n";
   os << indent << "MaximumStrokeLength: " << this->MaximumStrokeLength << "\n";
+  os << indent << "InstructionSet: " << GetInstructionSetAsString(GetInstructionSet()) << "\n";
   os << indent << "NumberOfAllocatedBricks: " << this->GetNumberOfAllocatedBricks() << "\n";
   os << indent << "UndoSteps: " << this->UndoStack.size() << " (" << this->UndoMemorySize / 1024 << " KiB of " << this->UndoMemoryBudget / 1024
      << " KiB)\n";

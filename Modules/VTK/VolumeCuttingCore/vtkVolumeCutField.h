@@ -284,6 +284,28 @@ public:
   size_t GetDenseMemorySize() const;
   ///@}
 
+  /// Instruction sets of the writer's per-sample loops.
+  enum InstructionSetType
+  {
+    InstructionSetBaseline = 0, ///< what the compiler targets by default
+    InstructionSetAVX2,
+    InstructionSetAVX512
+  };
+
+  ///@{
+  /**
+   * The instruction set the writer's loops use, for the whole process: the
+   * widest this build and processor have, unless set here. Every set gives
+   * bitwise the same field, so switching is safe at any time; it is here so
+   * that benchmarks and tests can compare them. SetInstructionSet returns
+   * false, changing nothing, for a set this build or processor lacks.
+   */
+  static bool SetInstructionSet(int set);
+  static int GetInstructionSet();
+  static bool IsInstructionSetAvailable(int set);
+  static const char* GetInstructionSetAsString(int set);
+  ///@}
+
 protected:
   vtkVolumeCutField();
   ~vtkVolumeCutField() override;

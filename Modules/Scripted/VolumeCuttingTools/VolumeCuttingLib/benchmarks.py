@@ -411,6 +411,30 @@ def cutfield(repeats: int) -> list[dict]:
             "whole-voxel removal of the same stroke at the CT's resolution",
             1000 * float(np.percentile(cutter_times, q)), len(field_times), machine))
 
+    # The same helix with each narrower instruction set the processor has:
+    # what a processor without the wider vectors (or a build without them) gets.
+    in_use = slicer.vtkVolumeCutField.GetInstructionSet()
+    for instruction_set in range(in_use):
+        if not slicer.vtkVolumeCutField.SetInstructionSet(instruction_set):
+            continue
+        narrow = slicer.vtkVolumeCutField()
+        narrow.Initialize(big, _grid(spacing, big), 2)
+        narrow_times = []
+        narrow.BeginStroke()
+        for p0, p1 in zip(poses[:-1], poses[1:]):
+            t0 = time.perf_counter()
+            narrow.CutCapsule(p0, p1, 2.5)
+            narrow_times.append(time.perf_counter() - t0)
+        narrow.EndStroke()
+        name = slicer.vtkVolumeCutField.GetInstructionSetAsString(instruction_set)
+        for label, q in (("p50", 50), ("p99", 99)):
+            results.append(measurement(
+                f"the same burr stroke with the {name} instruction set instead of {slicer.vtkVolumeCutField.GetInstructionSetAsString(in_use)}: {label}",
+                1000 * float(np.percentile(narrow_times, q)), "ms",
+                f"the stroke with {slicer.vtkVolumeCutField.GetInstructionSetAsString(in_use)} (above)",
+                1000 * float(np.percentile(field_times, q)), len(narrow_times), machine))
+    slicer.vtkVolumeCutField.SetInstructionSet(in_use)
+
     results.append(measurement(
         "closing that 2000-pose stroke into one undo step (EndStroke)", end_stroke_ms, "ms",
         "one pose of the stroke, p50 (above)", 1000 * float(np.percentile(field_times, 50)), 1, machine))

@@ -306,3 +306,28 @@ def test_a_huge_volume_is_refused_not_allocated():
     assert field.ComputeRemovedVolume() == before
     # 512^3 at factor 4 is within bounds (2^24 bricks, 256 MiB of directory).
     assert slicer.vtkVolumeCutField().Initialize([512, 512, 512], vtk.vtkMatrix4x4(), 4)
+
+
+def test_instruction_sets_cut_alike_and_refuse_what_is_missing():
+    field_class = slicer.vtkVolumeCutField
+    in_use = field_class.GetInstructionSet()
+    available = [s for s in range(3) if field_class.IsInstructionSetAvailable(s)]
+    assert field_class.InstructionSetBaseline in available
+    assert in_use == max(available)
+    assert not field_class.SetInstructionSet(7)
+    assert field_class.GetInstructionSet() == in_use
+    volumes = []
+    try:
+        for instruction_set in available:
+            assert field_class.SetInstructionSet(instruction_set)
+            assert field_class.GetInstructionSetAsString(instruction_set) in ("baseline", "AVX2", "AVX-512")
+            field = slicer.vtkVolumeCutField()
+            assert field.Initialize([40, 40, 40], oblique_grid(), 2)
+            assert field.CutCapsule([2.0, 10.5, 9.0], [5.0, 13.0, 11.5], 2.2)
+            volumes.append(field.ComputeRemovedVolume())
+    finally:
+        field_class.SetInstructionSet(in_use)
+    length = math.dist([2.0, 10.5, 9.0], [5.0, 13.0, 11.5])
+    exact = math.pi * 2.2**2 * length + 4.0 / 3.0 * math.pi * 2.2**3
+    assert abs(volumes[0] - exact) / exact < 0.005
+    assert all(v == volumes[0] for v in volumes)

@@ -1,0 +1,53 @@
+# Compiles each kernel variant (vtkVolumeCutKernels<Set>.cxx) at -O0 and -O2
+# with its instruction-set flags and fails if the object defines any global,
+# weak or unique symbol other than the variant's table.
+#
+# -DCOMPILER= -DNM= -DSOURCE_DIR= (VolumeCuttingCore) -DWORK_DIR=
+# -DCHECKS=<Set>:<flags separated by spaces>;...
+if(NOT CHECKS)
+  message(FATAL_ERROR "no kernel variants to check")
+endif()
+file(MAKE_DIRECTORY "${WORK_DIR}")
+set(checked 0)
+set(failures "")
+foreach(check IN LISTS CHECKS)
+  string(REGEX MATCH "^([^:]+):(.*)$" matched "${check}")
+  set(set "${CMAKE_MATCH_1}")
+  separate_arguments(flags UNIX_COMMAND "${CMAKE_MATCH_2}")
+  foreach(optimisation -O0 -O2)
+    set(object "${WORK_DIR}/${set}${optimisation}.o")
+    execute_process(
+      COMMAND "${COMPILER}" -std=c++17 ${optimisation} ${flags} -fno-math-errno -fno-trapping-math -ffp-contract=off
+        "-I${SOURCE_DIR}" -c "${SOURCE_DIR}/vtkVolumeCutKernels${set}.cxx" -o "${object}"
+      RESULT_VARIABLE result ERROR_VARIABLE errors)
+    if(NOT result EQUAL 0)
+      message(FATAL_ERROR "compiling the ${set} kernels (${optimisation}) failed:\n${errors}")
+    endif()
+    execute_process(COMMAND "${NM}" --defined-only "${object}" OUTPUT_VARIABLE symbols RESULT_VARIABLE result)
+    if(NOT result EQUAL 0)
+      message(FATAL_ERROR "${NM} could not read ${object}")
+    endif()
+    string(REPLACE "\n" ";" lines "${symbols}")
+    set(table_found FALSE)
+    foreach(line IN LISTS lines)
+      if(NOT line MATCHES "^[0-9a-fA-F]* ([A-Za-z]) (.+)$")
+        continue()
+      endif()
+      set(type "${CMAKE_MATCH_1}")
+      set(name "${CMAKE_MATCH_2}")
+      if(name MATCHES "vtkVolumeCutKernels[0-9]+${set}Table")
+        set(table_found TRUE)
+      elseif(type MATCHES "^[A-Zu]$")
+        string(APPEND failures "  ${set} ${optimisation}: ${type} ${name}\n")
+      endif()
+    endforeach()
+    if(NOT table_found)
+      string(APPEND failures "  ${set} ${optimisation}: its table is missing\n")
+    endif()
+    math(EXPR checked "${checked} + 1")
+  endforeach()
+endforeach()
+if(failures)
+  message(FATAL_ERROR "kernel variants define symbols the linker could share with other code:\n${failures}")
+endif()
+message(STATUS "${checked} kernel objects define their table alone")
