@@ -1,13 +1,18 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutFieldFile.h"
 #include "vtkVolumeCutFieldDistanceSource.h"
 #include "vtkVolumeCutKernels.h"
+#include "vtkVolumeCutProtection.h"
+#include "vtkVolumeCutProtectionBrick.h"
+#include "vtkVolumeCutSweepSources.h"
 
 #include "vtkDataArray.h"
 #include "vtkFlyingEdges3D.h"
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
+#include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
 #include "vtkMath.h"
 #include "vtkMatrix4x4.h"
@@ -22,7 +27,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <utility>
 
@@ -38,15 +42,6 @@ static_assert(Outside == std::numeric_limits<int16_t>::max() && Inside == -Outsi
 static_assert(SamplesPerBrick == vtkVolumeCutKernels::SamplesPerBrick, "kernels work on whole bricks");
 static_assert(int(vtkVolumeCutField::InstructionSetAVX2) == int(vtkVolumeCutKernels::AVX2) && int(vtkVolumeCutField::InstructionSetAVX512) == int(vtkVolumeCutKernels::AVX512),
   "one numbering of the instruction sets");
-
-double DistanceToSegment(const double p[3], const double a[3], const double ab[3], double abLength2)
-{
-  double ap[3] = { p[0] - a[0], p[1] - a[1], p[2] - a[2] };
-  double t = abLength2 > 0.0 ? (ap[0] * ab[0] + ap[1] * ab[1] + ap[2] * ab[2]) / abLength2 : 0.0;
-  t = std::min(1.0, std::max(0.0, t));
-  const double d[3] = { ap[0] - t * ab[0], ap[1] - t * ab[1], ap[2] - t * ab[2] };
-  return std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-}
 
 bool IsFinite(const double v[3])
 {
@@ -101,13 +96,6 @@ struct vtkVolumeCutField::Brick
 static_assert(sizeof(std::atomic<int16_t>) == sizeof(int16_t), "16-bit atomics must have the layout of the integer");
 
 //------------------------------------------------------------------------------
-struct vtkVolumeCutField::ProtectionBrick
-{
-  int16_t Distance[SamplesPerBrick]; // to the union of protected voxel cubes, negative inside
-  uint8_t Label[SamplesPerBrick];    // the nearest protected structure
-};
-
-//------------------------------------------------------------------------------
 /// One stroke's bricks as they were before it (empty values: the brick did
 /// not exist, all Outside). The state after it is read back when the stroke
 /// is undone (until then the field holds it: every later change is a later
@@ -136,6 +124,7 @@ struct vtkVolumeCutField::UndoStep
 
 //------------------------------------------------------------------------------
 vtkVolumeCutField::vtkVolumeCutField()
+  : Protection(vtkSmartPointer<vtkVolumeCutProtection>::New())
 {
   vtkMatrix4x4::Identity(&this->SubIJKToRAS[0][0]);
   vtkMatrix4x4::Identity(&this->RASToSubIJK[0][0]);
@@ -248,6 +237,12 @@ bool vtkVolumeCutField::Initialize(const int anatomyDimensions[3], vtkMatrix4x4*
   // Beyond the correction's largest size (0.75 of the largest spacing) and
   // the normal's finite differences: 3 spacings, inside the band.
   this->CorrectionReach = 3.0 * std::max({ spacing[0], spacing[1], spacing[2] });
+  double anatomySpacing[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    anatomySpacing[axis] = spacing[axis] * subVoxelFactor;
+  }
+  this->Protection->SetFieldGeometry(anatomyDimensions, subVoxelFactor, anatomySpacing, this->BandWidth, this->Quantum);
   this->RowScratch.assign(static_cast<size_t>(BrickSize) * BrickSize * dimensions[0], Outside);
   this->DistanceScratch.assign(static_cast<size_t>(dimensions[0]), 0.0f);
   this->BrickSampleOffsets.resize(3 * SamplesPerBrick);
@@ -301,7 +296,7 @@ void vtkVolumeCutField::Reset()
   this->StrokeOpen = false;
   this->StrokeBefore.clear();
   this->StrokeBeforeMemory = 0;
-  this->ProtectionBricks.clear();
+  this->Protection->RemoveAllLabelImages();
   this->LastCapsule.Valid = false;
   this->ResetContact();
 }
@@ -317,149 +312,52 @@ void vtkVolumeCutField::ResetContact()
 }
 
 //------------------------------------------------------------------------------
-const vtkVolumeCutField::ProtectionBrick* vtkVolumeCutField::GetProtectionBrick(vtkIdType brickId) const
+const vtkVolumeCutProtection::Brick* vtkVolumeCutField::GetProtectionBrick(vtkIdType brickId)
 {
-  return this->ProtectionBricks.empty() ? nullptr : this->ProtectionBricks[brickId].get();
+  return this->Protection->GetBrick(brickId);
 }
 
 //------------------------------------------------------------------------------
 bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
 {
-  this->ProtectionBricks.clear();
-  this->LastCapsule.Valid = false; // what the last capsule could cut has changed
+  if (labels)
+  {
+    const int f = this->SubVoxelFactor;
+    int dims[3];
+    labels->GetDimensions(dims);
+    if (!this->Directory || f < 1 || dims[0] * f != this->Dimensions[0] || dims[1] * f != this->Dimensions[1] || dims[2] * f != this->Dimensions[2])
+    {
+      vtkErrorMacro("SetProtectedLabels: the labels must have the anatomy's dimensions (" << this->Dimensions[0] / std::max(f, 1) << " x "
+                                                                                          << this->Dimensions[1] / std::max(f, 1) << " x "
+                                                                                          << this->Dimensions[2] / std::max(f, 1) << ")");
+      return false;
+    }
+    vtkDataArray* scalars = labels->GetPointData()->GetScalars();
+    if (!scalars || !scalars->IsIntegral() || scalars->GetNumberOfComponents() != 1)
+    {
+      vtkErrorMacro("SetProtectedLabels: the labels need one integer scalar component");
+      return false;
+    }
+  }
+  this->Protection->RemoveAllLabelImages();
   if (!labels)
   {
     return true;
   }
-  const int f = this->SubVoxelFactor;
+  // Anatomy IJK: the image's extent starts at voxel 0 whatever its origin.
+  vtkNew<vtkImageData> ijkLabels;
+  ijkLabels->ShallowCopy(labels);
   int dims[3];
   labels->GetDimensions(dims);
-  if (!this->Directory || f < 1 || dims[0] * f != this->Dimensions[0] || dims[1] * f != this->Dimensions[1] || dims[2] * f != this->Dimensions[2])
+  ijkLabels->SetExtent(0, dims[0] - 1, 0, dims[1] - 1, 0, dims[2] - 1);
+  const int image = this->Protection->AddLabelImage(ijkLabels);
+  double range[2];
+  labels->GetPointData()->GetScalars()->GetRange(range, 0);
+  const int largest = static_cast<int>(std::min<double>(range[1], vtkVolumeCutProtection::MaximumLabelValue));
+  for (int value = 1; value <= largest; ++value)
   {
-    vtkErrorMacro("SetProtectedLabels: the labels must have the anatomy's dimensions (" << this->Dimensions[0] / std::max(f, 1) << " x "
-                                                                                        << this->Dimensions[1] / std::max(f, 1) << " x "
-                                                                                        << this->Dimensions[2] / std::max(f, 1) << ")");
-    return false;
+    this->Protection->SetShieldLabel(image, value, std::min(value, 255));
   }
-  vtkDataArray* scalars = labels->GetPointData()->GetScalars();
-  if (!scalars)
-  {
-    vtkErrorMacro("SetProtectedLabels: the labels have no scalars");
-    return false;
-  }
-  const vtkIdType voxelCount = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
-  std::vector<uint8_t> label(static_cast<size_t>(voxelCount), 0);
-  int lower[3] = { dims[0], dims[1], dims[2] };
-  int upper[3] = { -1, -1, -1 };
-  for (vtkIdType n = 0; n < voxelCount; ++n)
-  {
-    const double value = scalars->GetComponent(n, 0);
-    if (value > 0.0)
-    {
-      label[n] = static_cast<uint8_t>(std::min(255.0, value));
-      const int v[3] = { static_cast<int>(n % dims[0]), static_cast<int>((n / dims[0]) % dims[1]), static_cast<int>(n / (static_cast<vtkIdType>(dims[0]) * dims[1])) };
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        lower[axis] = std::min(lower[axis], v[axis]);
-        upper[axis] = std::max(upper[axis], v[axis]);
-      }
-    }
-  }
-  if (upper[0] < 0)
-  {
-    return true; // nothing protected
-  }
-  // Anatomy spacing along each axis (orthogonal axes: the distance to a voxel
-  // cube is then the per-axis excess over its half width, scaled).
-  double spacing[3];
-  this->GetSubVoxelSpacing(spacing);
-  double anatomySpacing[3] = { spacing[0] * f, spacing[1] * f, spacing[2] * f };
-  const int reach = static_cast<int>(std::ceil(this->BandWidth / std::min({ anatomySpacing[0], anatomySpacing[1], anatomySpacing[2] }))) + 1;
-  auto isProtected = [&](int i, int j, int k) -> uint8_t {
-    if (i < 0 || j < 0 || k < 0 || i >= dims[0] || j >= dims[1] || k >= dims[2])
-    {
-      return 0;
-    }
-    return label[(static_cast<size_t>(k) * dims[1] + j) * dims[0] + i];
-  };
-
-  const vtkIdType totalBricks = static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2];
-  this->ProtectionBricks.resize(static_cast<size_t>(totalBricks));
-  int brickLower[3];
-  int brickUpper[3];
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    brickLower[axis] = std::max(0, (lower[axis] - reach) * f) / BrickSize;
-    brickUpper[axis] = std::min(this->Dimensions[axis] - 1, (upper[axis] + reach + 1) * f) / BrickSize;
-  }
-  const double inverseQuantum = 1.0 / this->Quantum;
-  for (int bk = brickLower[2]; bk <= brickUpper[2]; ++bk)
-  {
-    for (int bj = brickLower[1]; bj <= brickUpper[1]; ++bj)
-    {
-      for (int bi = brickLower[0]; bi <= brickUpper[0]; ++bi)
-      {
-        std::unique_ptr<ProtectionBrick> brick(new ProtectionBrick);
-        bool useful = false;
-        for (int local = 0; local < SamplesPerBrick; ++local)
-        {
-          const int s[3] = { bi * BrickSize + local % BrickSize, bj * BrickSize + (local / BrickSize) % BrickSize, bk * BrickSize + local / (BrickSize * BrickSize) };
-          double a[3];
-          int v[3];
-          for (int axis = 0; axis < 3; ++axis)
-          {
-            a[axis] = (s[axis] + 0.5) / f - 0.5;
-            v[axis] = static_cast<int>(std::lround(a[axis]));
-          }
-          const uint8_t own = isProtected(v[0], v[1], v[2]);
-          // Inside: distance to the nearest unprotected cube; outside: to the
-          // nearest protected one. Cubes span index +-0.5 around their voxel.
-          double nearest2 = std::numeric_limits<double>::max();
-          uint8_t nearestLabel = own;
-          for (int dk = -reach; dk <= reach; ++dk)
-          {
-            for (int dj = -reach; dj <= reach; ++dj)
-            {
-              for (int di = -reach; di <= reach; ++di)
-              {
-                const int c[3] = { v[0] + di, v[1] + dj, v[2] + dk };
-                const uint8_t other = isProtected(c[0], c[1], c[2]);
-                if ((own != 0) == (other != 0))
-                {
-                  continue;
-                }
-                double d2 = 0.0;
-                for (int axis = 0; axis < 3; ++axis)
-                {
-                  const double excess = std::max(0.0, std::abs(a[axis] - c[axis]) - 0.5) * anatomySpacing[axis];
-                  d2 += excess * excess;
-                }
-                if (d2 < nearest2)
-                {
-                  nearest2 = d2;
-                  if (!own)
-                  {
-                    nearestLabel = other;
-                  }
-                }
-              }
-            }
-          }
-          const double distance = nearest2 == std::numeric_limits<double>::max() ? this->BandWidth : std::sqrt(nearest2);
-          const double signedDistance = own ? -distance : distance;
-          const double clamped = std::min(this->BandWidth, std::max(-this->BandWidth, signedDistance));
-          brick->Distance[local] = static_cast<int16_t>(std::lround(clamped * inverseQuantum));
-          brick->Label[local] = nearestLabel;
-          useful |= signedDistance < this->BandWidth;
-        }
-        if (useful)
-        {
-          this->ProtectionBricks[(static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi] = std::move(brick);
-        }
-      }
-    }
-  }
-  this->Modified();
   return true;
 }
 
@@ -563,235 +461,6 @@ void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick
   this->StrokeBeforeMemory += UndoStep::EntryMemory(values);
 }
 
-//------------------------------------------------------------------------------
-namespace
-{
-/// The sweep of a sphere: a capsule, written a brick at a time with a
-/// vectorised distance loop.
-class CapsuleSource : public vtkVolumeCutField::BrickDistanceSource
-{
-public:
-  /// startCovered: the ball at p0 was cut already (a continued path), so
-  /// only samples ahead of p0 along the segment can change.
-  CapsuleSource(const double p0[3], const double p1[3], double radius, double reach, bool startCovered)
-    : Radius(radius)
-    , Reach(reach)
-    , StartCovered(startCovered)
-  {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      this->P0[axis] = p0[axis];
-      this->P1[axis] = p1[axis];
-      this->Ab[axis] = p1[axis] - p0[axis];
-    }
-    this->AbLength2 = this->Ab[0] * this->Ab[0] + this->Ab[1] * this->Ab[1] + this->Ab[2] * this->Ab[2];
-  }
-  void GetReachBounds(double lower[3], double upper[3]) const override
-  {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      lower[axis] = std::min(this->P0[axis], this->P1[axis]) - this->Reach;
-      upper[axis] = std::max(this->P0[axis], this->P1[axis]) + this->Reach;
-    }
-  }
-  double Distance(const double point[3]) const override { return DistanceToSegment(point, this->P0, this->Ab, this->AbLength2) - this->Radius; }
-
-  bool MayReach(const double center[3], double radius) const override
-  {
-    if (DistanceToSegment(center, this->P0, this->Ab, this->AbLength2) - radius > this->Reach)
-    {
-      return false;
-    }
-    if (this->StartCovered && this->AbLength2 > 0.0)
-    {
-      const double ahead = (center[0] - this->P0[0]) * this->Ab[0] + (center[1] - this->P0[1]) * this->Ab[1] + (center[2] - this->P0[2]) * this->Ab[2];
-      return ahead + radius * std::sqrt(this->AbLength2) > 0.0;
-    }
-    return true;
-  }
-  void BrickDistances(const double origin[3], const double* /*center*/, double /*radius*/, const float* offsets, float* distances) const override
-  {
-    const float w0[3] = { static_cast<float>(origin[0] - this->P0[0]), static_cast<float>(origin[1] - this->P0[1]),
-      static_cast<float>(origin[2] - this->P0[2]) };
-    const float ab[3] = { static_cast<float>(this->Ab[0]), static_cast<float>(this->Ab[1]), static_cast<float>(this->Ab[2]) };
-    const float inverseLength2 = this->AbLength2 > 0.0 ? static_cast<float>(1.0 / this->AbLength2) : 0.0f;
-    // Behind the start of a continued path the field holds the ball already:
-    // far away there means unchanged.
-    const float behindLimit = this->StartCovered && this->AbLength2 > 0.0 ? 0.0f : -std::numeric_limits<float>::infinity();
-    vtkVolumeCutKernels::Get().CapsuleBrickDistances(w0, ab, inverseLength2, static_cast<float>(this->Radius), behindLimit, static_cast<float>(2.0 * this->Reach), offsets, distances);
-  }
-
-private:
-  double P0[3];
-  double P1[3];
-  double Ab[3];
-  double AbLength2 = 0.0;
-  double Radius;
-  double Reach;
-  bool StartCovered;
-};
-} // namespace
-
-namespace
-{
-/// A rigid pose: tool-to-RAS rotation and translation.
-struct RigidPose
-{
-  double Rotation[3][3];
-  double Translation[3];
-};
-
-/// A brick's samples (origin + offsets) in the frame of the tool at pose.
-void ToToolFrame(const RigidPose& pose, const double origin[3], const float* offsets,
-  float local[3][vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize])
-{
-  float rotation[3][3];
-  for (int row = 0; row < 3; ++row)
-  {
-    for (int column = 0; column < 3; ++column)
-    {
-      rotation[row][column] = static_cast<float>(pose.Rotation[row][column]);
-    }
-  }
-  const float w0[3] = { static_cast<float>(origin[0] - pose.Translation[0]), static_cast<float>(origin[1] - pose.Translation[1]),
-    static_cast<float>(origin[2] - pose.Translation[2]) };
-  vtkVolumeCutKernels::Get().ToToolFrame(rotation, w0, offsets, local[0], local[1], local[2]);
-}
-
-/// The sweep of any tool: the tool at poses close enough that the union of
-/// its copies covers the continuous sweep to within half a sub-voxel. Written
-/// a brick at a time: each copy whose reach sphere meets a brick is evaluated
-/// at all its samples in one batch (vtkVolumeCutTool::EvaluateDistances).
-class SweptToolSource : public vtkVolumeCutField::BrickDistanceSource
-{
-public:
-  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach)
-    : Tool(tool)
-    , Poses(std::move(poses))
-    , Reach(reach)
-  {
-  }
-  void GetReachBounds(double lower[3], double upper[3]) const override
-  {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      lower[axis] = std::numeric_limits<double>::max();
-      upper[axis] = -std::numeric_limits<double>::max();
-      for (const RigidPose& pose : this->Poses)
-      {
-        lower[axis] = std::min(lower[axis], pose.Translation[axis] - this->Reach);
-        upper[axis] = std::max(upper[axis], pose.Translation[axis] + this->Reach);
-      }
-    }
-  }
-  bool MayReach(const double center[3], double radius) const override
-  {
-    for (const RigidPose& pose : this->Poses)
-    {
-      if (this->Meets(pose, center, radius))
-      {
-        return true;
-      }
-    }
-    return false;
-  }
-  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override
-  {
-    constexpr int samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
-    // Beyond the band: clamped to Outside, so a copy out of reach changes nothing.
-    const float far = static_cast<float>(this->Reach);
-    std::fill(distances, distances + samples, far);
-    float local[3][samples];
-    float copy[samples];
-    for (const RigidPose& pose : this->Poses)
-    {
-      if (!this->Meets(pose, center, radius))
-      {
-        continue;
-      }
-      ToToolFrame(pose, origin, offsets, local);
-      this->Tool->EvaluateDistances(local[0], local[1], local[2], samples, copy);
-      vtkVolumeCutKernels::Get().MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
-    }
-  }
-  double Distance(const double point[3]) const override
-  {
-    double nearest = this->Reach; // beyond the band: any value this large is clamped
-    for (const RigidPose& pose : this->Poses)
-    {
-      const double w[3] = { point[0] - pose.Translation[0], point[1] - pose.Translation[1], point[2] - pose.Translation[2] };
-      const double centreDistance2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-      if (centreDistance2 > this->Reach * this->Reach)
-      {
-        continue; // this copy of the tool is farther than the band
-      }
-      double local[3];
-      for (int row = 0; row < 3; ++row)
-      {
-        local[row] = pose.Rotation[0][row] * w[0] + pose.Rotation[1][row] * w[1] + pose.Rotation[2][row] * w[2];
-      }
-      nearest = std::min(nearest, this->Tool->EvaluateDistance(local));
-    }
-    return nearest;
-  }
-
-private:
-  /// Whether the copy of the tool at pose reaches into the ball.
-  bool Meets(const RigidPose& pose, const double center[3], double radius) const
-  {
-    const double w[3] = { center[0] - pose.Translation[0], center[1] - pose.Translation[1], center[2] - pose.Translation[2] };
-    const double limit = this->Reach + radius;
-    return w[0] * w[0] + w[1] * w[1] + w[2] * w[2] <= limit * limit;
-  }
-
-  vtkVolumeCutTool* Tool;
-  std::vector<RigidPose> Poses;
-  double Reach;
-};
-
-bool ToRigidPose(vtkMatrix4x4* matrix, RigidPose& pose)
-{
-  if (!matrix)
-  {
-    return false;
-  }
-  for (int row = 0; row < 3; ++row)
-  {
-    for (int column = 0; column < 3; ++column)
-    {
-      pose.Rotation[row][column] = matrix->GetElement(row, column);
-    }
-    pose.Translation[row] = matrix->GetElement(row, 3);
-  }
-  for (int row = 0; row < 4; ++row)
-  {
-    for (int column = 0; column < 4; ++column)
-    {
-      if (!std::isfinite(matrix->GetElement(row, column)))
-      {
-        return false;
-      }
-    }
-  }
-  // Rigid: orthonormal columns, no reflection.
-  for (int a = 0; a < 3; ++a)
-  {
-    for (int b = 0; b < 3; ++b)
-    {
-      double dot = 0.0;
-      for (int row = 0; row < 3; ++row)
-      {
-        dot += pose.Rotation[row][a] * pose.Rotation[row][b];
-      }
-      if (std::abs(dot - (a == b ? 1.0 : 0.0)) > 1e-6)
-      {
-        return false;
-      }
-    }
-  }
-  return vtkMath::Determinant3x3(pose.Rotation) > 0.0;
-}
-} // namespace
 
 //------------------------------------------------------------------------------
 bool vtkVolumeCutField::CutToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
@@ -819,9 +488,9 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
     vtkErrorMacro(<< caller << ": no valid tool; nothing was cut");
     return false;
   }
-  RigidPose start;
-  RigidPose end;
-  if (!ToRigidPose(pose0, start) || !ToRigidPose(pose1, end))
+  vtkVolumeCutSweeps::RigidPose start;
+  vtkVolumeCutSweeps::RigidPose end;
+  if (!vtkVolumeCutSweeps::ToRigidPose(pose0, start) || !vtkVolumeCutSweeps::ToRigidPose(pose1, end))
   {
     vtkErrorMacro(<< caller << ": a tool pose is not a finite rigid transform; nothing was cut");
     return false;
@@ -833,54 +502,12 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
                   << " mm accepted as one stroke; nothing was cut");
     return false;
   }
-  // Rotation between the poses as a quaternion; intermediate poses by
-  // spherical interpolation, dense enough that no tool point moves more than
-  // half a sub-voxel from one to the next.
-  double q0[4];
-  double q1[4];
-  vtkMath::Matrix3x3ToQuaternion(start.Rotation, q0);
-  vtkMath::Matrix3x3ToQuaternion(end.Rotation, q1);
-  double cosine = q0[0] * q1[0] + q0[1] * q1[1] + q0[2] * q1[2] + q0[3] * q1[3];
-  if (cosine < 0.0)
-  {
-    cosine = -cosine;
-    for (double& component : q1)
-    {
-      component = -component;
-    }
-  }
-  const double angle = 2.0 * std::acos(std::min(1.0, cosine));
+  // No tool point moves more than half a sub-voxel from one pose to the next.
   double spacing[3];
   this->GetSubVoxelSpacing(spacing);
   const double step = 0.5 * std::min({ spacing[0], spacing[1], spacing[2] });
-  const double travel = jump + angle * tool->GetBoundingRadius();
-  const int intervals = std::max(1, std::min(100000, static_cast<int>(std::ceil(travel / step))));
-  std::vector<RigidPose> poses(static_cast<size_t>(intervals) + 1);
-  for (int n = 0; n <= intervals; ++n)
-  {
-    const double t = static_cast<double>(n) / intervals;
-    double q[4];
-    const double half = 0.5 * angle;
-    if (half < 1e-9)
-    {
-      std::copy(q0, q0 + 4, q);
-    }
-    else
-    {
-      const double w0 = std::sin((1.0 - t) * half) / std::sin(half);
-      const double w1 = std::sin(t * half) / std::sin(half);
-      for (int c = 0; c < 4; ++c)
-      {
-        q[c] = w0 * q0[c] + w1 * q1[c];
-      }
-    }
-    vtkMath::QuaternionToMatrix3x3(q, poses[n].Rotation);
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      poses[n].Translation[axis] = (1.0 - t) * start.Translation[axis] + t * end.Translation[axis];
-    }
-  }
-  const SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
+  std::vector<vtkVolumeCutSweeps::RigidPose> poses = vtkVolumeCutSweeps::InterpolatePoses(start, end, tool->GetBoundingRadius(), step);
+  const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
   this->ApplyDistance(source, operation);
   return true;
 }
@@ -894,14 +521,16 @@ bool vtkVolumeCutField::ApplyCapsule(const double p0[3], const double p1[3], dou
     return false;
   }
   const CapsuleContinuation& last = this->LastCapsule;
-  const bool continued = operation == Operation::Cut && last.Valid && last.Stamp == this->GetCurrentStamp() && last.Radius == radius &&
+  const bool continued = operation == Operation::Cut && last.Valid && last.Stamp == this->GetCurrentStamp() &&
+    last.ProtectionTime == this->Protection->GetMTime() && last.Radius == radius &&
     last.End[0] == p0[0] && last.End[1] == p0[1] && last.End[2] == p0[2];
-  const CapsuleSource source(p0, p1, radius, radius + this->BandWidth, continued);
+  const vtkVolumeCutSweeps::CapsuleSource source(p0, p1, radius, radius + this->BandWidth, continued);
   this->ApplyDistance(source, operation);
   this->LastCapsule.Valid = operation == Operation::Cut;
   std::copy(p1, p1 + 3, this->LastCapsule.End);
   this->LastCapsule.Radius = radius;
   this->LastCapsule.Stamp = this->GetCurrentStamp();
+  this->LastCapsule.ProtectionTime = this->Protection->GetMTime();
   return true;
 }
 
@@ -990,7 +619,7 @@ void vtkVolumeCutField::QuantizeDistances(const float* distances, int count, Ope
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumeCutField::MergeSegment(const Brick* brick, const ProtectionBrick* protection, const int brickIndex[3], const int16_t* quantized,
+bool vtkVolumeCutField::MergeSegment(const Brick* brick, const vtkVolumeCutProtection::Brick* protection, const int brickIndex[3], const int16_t* quantized,
   int rowStart, int count, Operation operation, const DistanceSource& source, int16_t* merged)
 {
   // Cut: min(field, tool distance). Restore: max(field, -tool distance).
@@ -1136,7 +765,7 @@ bool vtkVolumeCutField::ApplyRowwise(const RowDistanceSource& source, Operation 
         {
           continue; // nothing removed here, nothing to put back
         }
-        const ProtectionBrick* protection = this->GetProtectionBrick(brickId);
+        const vtkVolumeCutProtection::Brick* protection = this->GetProtectionBrick(brickId);
         const int brickIndex[3] = { bi, bj, bk };
         int runCount = 0;
         for (int r = 0; r < rowCount; ++r)
@@ -1211,7 +840,7 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
         // Samples past the volume's far faces exist in the brick, not in the field.
         const int valid[3] = { std::min(BrickSize, this->Dimensions[0] - bi * BrickSize), std::min(BrickSize, this->Dimensions[1] - bj * BrickSize),
           std::min(BrickSize, this->Dimensions[2] - bk * BrickSize) };
-        const ProtectionBrick* protection = this->GetProtectionBrick(brickId);
+        const vtkVolumeCutProtection::Brick* protection = this->GetProtectionBrick(brickId);
         const bool whole = valid[0] == BrickSize && valid[1] == BrickSize && valid[2] == BrickSize;
         if (whole && !this->MergeSegment(brick, protection, brickIndex, quantized, 0, SamplesPerBrick, operation, source, merged))
         {
@@ -1509,7 +1138,24 @@ double vtkVolumeCutField::GetSignedDistance(const double ras[3]) const
 }
 
 //------------------------------------------------------------------------------
+vtkMTimeType vtkVolumeCutField::GetMTime()
+{
+  return std::max(this->Superclass::GetMTime(), this->Protection->GetMTime());
+}
+
+//------------------------------------------------------------------------------
 double vtkVolumeCutField::GetRemovedFraction(int i, int j, int k) const
+{
+  const int f = std::max(this->SubVoxelFactor, 1);
+  if (this->ReadSample(i, j, k) >= 0 && i >= 0 && j >= 0 && k >= 0 && this->Protection->GetShieldLabel(i / f, j / f, k / f) != 0)
+  {
+    return 0.0;
+  }
+  return this->ComputeRemovedFraction(i, j, k);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutField::ComputeRemovedFraction(int i, int j, int k) const
 {
   const int16_t sample = this->ReadSample(i, j, k);
   const double distance = sample * this->Quantum;
@@ -1557,22 +1203,28 @@ double vtkVolumeCutField::GetRemovedFraction(int i, int j, int k) const
 
 //------------------------------------------------------------------------------
 template <typename Visitor>
-void vtkVolumeCutField::ForEachAllocatedSample(Visitor&& visit) const
+void vtkVolumeCutField::ForEachAllocatedSampleWithShield(Visitor&& visit) const
 {
+  const int f = std::max(this->SubVoxelFactor, 1);
+  const int anatomyPerBrick = BrickSize / f; // bricks hold whole anatomy voxels
+  std::vector<uint8_t> shield(static_cast<size_t>(anatomyPerBrick) * anatomyPerBrick * anatomyPerBrick);
   const vtkIdType count = this->NumberOfAllocatedBricks.load(std::memory_order_acquire);
   for (vtkIdType n = 0; n < count; ++n)
   {
     const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
-    const int bi = static_cast<int>(brickId % this->BrickDimensions[0]);
-    const int bj = static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]);
-    const int bk = static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1]));
-    for (int k = bk * BrickSize; k < std::min((bk + 1) * BrickSize, this->Dimensions[2]); ++k)
+    const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
+      static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+    const int voxelLower[3] = { b[0] * anatomyPerBrick, b[1] * anatomyPerBrick, b[2] * anatomyPerBrick };
+    const int voxelUpper[3] = { voxelLower[0] + anatomyPerBrick - 1, voxelLower[1] + anatomyPerBrick - 1, voxelLower[2] + anatomyPerBrick - 1 };
+    this->Protection->GetShieldLabels(voxelLower, voxelUpper, shield.data());
+    for (int k = b[2] * BrickSize; k < std::min((b[2] + 1) * BrickSize, this->Dimensions[2]); ++k)
     {
-      for (int j = bj * BrickSize; j < std::min((bj + 1) * BrickSize, this->Dimensions[1]); ++j)
+      for (int j = b[1] * BrickSize; j < std::min((b[1] + 1) * BrickSize, this->Dimensions[1]); ++j)
       {
-        for (int i = bi * BrickSize; i < std::min((bi + 1) * BrickSize, this->Dimensions[0]); ++i)
+        const uint8_t* shieldRow = &shield[((k / f - voxelLower[2]) * anatomyPerBrick + (j / f - voxelLower[1])) * anatomyPerBrick - voxelLower[0]];
+        for (int i = b[0] * BrickSize; i < std::min((b[0] + 1) * BrickSize, this->Dimensions[0]); ++i)
         {
-          visit(i, j, k);
+          visit(i, j, k, shieldRow[i / f] != 0);
         }
       }
     }
@@ -1587,7 +1239,12 @@ double vtkVolumeCutField::ComputeRemovedVolume() const
     return 0.0;
   }
   double removed = 0.0;
-  this->ForEachAllocatedSample([&](int i, int j, int k) { removed += this->GetRemovedFraction(i, j, k); });
+  this->ForEachAllocatedSampleWithShield([&](int i, int j, int k, bool shielded) {
+    if (!shielded || this->ReadSample(i, j, k) < 0)
+    {
+      removed += this->ComputeRemovedFraction(i, j, k);
+    }
+  });
   const double subVoxelVolume = std::abs(vtkMatrix4x4::Determinant(&this->SubIJKToRAS[0][0]));
   return removed * subVoxelVolume;
 }
@@ -1613,15 +1270,75 @@ void vtkVolumeCutField::ExportRemovedFraction(vtkImageData* anatomyFraction) con
   {
     return;
   }
-  float* fractions = scalars->GetPointer(0);
+  vtkNew<vtkIdTypeArray> voxelIds;
+  vtkNew<vtkFloatArray> fractions;
+  this->ExportRemovedVoxels(voxelIds, fractions);
+  float* values = scalars->GetPointer(0);
+  for (vtkIdType n = 0; n < voxelIds->GetNumberOfValues(); ++n)
+  {
+    values[voxelIds->GetValue(n)] = fractions->GetValue(n);
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ExportRemovedVoxels(vtkIdTypeArray* anatomyVoxelIds, vtkFloatArray* fractions) const
+{
+  if (!anatomyVoxelIds || !fractions)
+  {
+    vtkErrorMacro("ExportRemovedVoxels: no output arrays");
+    return;
+  }
+  anatomyVoxelIds->Reset();
+  fractions->Reset();
+  fractions->SetName("RemovedFraction");
+  if (!this->Directory)
+  {
+    return;
+  }
+  // Bricks hold whole anatomy voxels, so each voxel is complete once its
+  // brick has been visited: sum a brick's sub-voxels, then emit its voxels.
+  const int f = std::max(this->SubVoxelFactor, 1);
+  const int dims[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
   const double perSubVoxel = 1.0 / (f * f * f);
-  this->ForEachAllocatedSample([&](int i, int j, int k) {
-    const double fraction = this->GetRemovedFraction(i, j, k);
-    if (fraction > 0.0)
+  std::vector<std::pair<vtkIdType, double>> brickVoxels;
+  vtkIdType currentBrick = -1;
+  auto flush = [&]() {
+    std::sort(brickVoxels.begin(), brickVoxels.end());
+    for (size_t n = 0; n < brickVoxels.size();)
     {
-      fractions[(static_cast<vtkIdType>(k / f) * dims[1] + j / f) * dims[0] + i / f] += static_cast<float>(fraction * perSubVoxel);
+      double sum = 0.0;
+      size_t m = n;
+      for (; m < brickVoxels.size() && brickVoxels[m].first == brickVoxels[n].first; ++m)
+      {
+        sum += brickVoxels[m].second;
+      }
+      if (sum > 0.0)
+      {
+        anatomyVoxelIds->InsertNextValue(brickVoxels[n].first);
+        fractions->InsertNextValue(static_cast<float>(std::min(1.0, sum * perSubVoxel)));
+      }
+      n = m;
+    }
+    brickVoxels.clear();
+  };
+  this->ForEachAllocatedSampleWithShield([&](int i, int j, int k, bool shielded) {
+    const vtkIdType brick = (static_cast<vtkIdType>(k / BrickSize) * this->BrickDimensions[1] + j / BrickSize) * this->BrickDimensions[0] + i / BrickSize;
+    if (brick != currentBrick)
+    {
+      flush();
+      currentBrick = brick;
+    }
+    if (shielded && this->ReadSample(i, j, k) >= 0)
+    {
+      return;
+    }
+    const double fraction = this->ComputeRemovedFraction(i, j, k);
+    if (fraction > 0.0 && i / f < dims[0] && j / f < dims[1] && k / f < dims[2])
+    {
+      brickVoxels.emplace_back((static_cast<vtkIdType>(k / f) * dims[1] + j / f) * dims[0] + i / f, fraction);
     }
   });
+  flush();
 }
 
 //------------------------------------------------------------------------------
@@ -1756,148 +1473,116 @@ void vtkVolumeCutField::ExtractRemovedSurface(vtkPolyData* surface) const
   surface->ShallowCopy(toRas->GetOutput());
 }
 
-namespace
-{
-// File layout, little-endian: magic, version, anatomy dimensions (3 x int32),
-// sub-voxel factor (int32), anatomy IJK-to-RAS (16 x float64), quantum
-// (float64), brick count (int64), then per brick its ID (int64) and its
-// samples (BrickSize^3 x int16). The band follows from the geometry.
-const char CutFieldMagic[8] = { 'V', 'C', 'U', 'T', 'F', 'L', 'D', '\0' };
-const int32_t CutFieldFileVersion = 1;
-
-template <typename T>
-void WriteValue(std::ofstream& stream, const T& value)
-{
-  stream.write(reinterpret_cast<const char*>(&value), sizeof(T));
-}
-
-template <typename T>
-bool ReadValue(std::ifstream& stream, T& value)
-{
-  return static_cast<bool>(stream.read(reinterpret_cast<char*>(&value), sizeof(T)));
-}
-} // namespace
-
 //------------------------------------------------------------------------------
 bool vtkVolumeCutField::WriteFile(const char* fileName) const
 {
-  if (!fileName)
-  {
-    vtkErrorMacro("WriteFile: no file name");
-    return false;
-  }
-  std::ofstream stream(fileName, std::ios::binary | std::ios::trunc);
-  if (!stream)
-  {
-    vtkErrorMacro("WriteFile: cannot open " << fileName << " for writing");
-    return false;
-  }
-  // A field not initialized yet (nothing cut) is written with zero dimensions.
-  const int f = std::max(this->SubVoxelFactor, 1);
-  stream.write(CutFieldMagic, sizeof(CutFieldMagic));
-  WriteValue(stream, CutFieldFileVersion);
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    WriteValue(stream, static_cast<int32_t>(this->Dimensions[axis] / f));
-  }
-  WriteValue(stream, static_cast<int32_t>(f));
-  for (double element : this->AnatomyIJKToRAS)
-  {
-    WriteValue(stream, element);
-  }
-  WriteValue(stream, this->Quantum);
-  const vtkIdType count = this->Directory ? this->NumberOfAllocatedBricks.load(std::memory_order_acquire) : 0;
-  WriteValue(stream, static_cast<int64_t>(count));
-  short values[SamplesPerBrick];
-  for (vtkIdType n = 0; n < count; ++n)
-  {
-    const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
-    this->CopyBrick(brickId, values);
-    WriteValue(stream, static_cast<int64_t>(brickId));
-    stream.write(reinterpret_cast<const char*>(values), sizeof(values));
-  }
-  if (!stream.flush())
-  {
-    vtkErrorMacro("WriteFile: writing " << fileName << " failed");
-    return false;
-  }
-  return true;
+  vtkNew<vtkVolumeCutFieldFile> file;
+  file->SetFileName(fileName);
+  return file->Write(const_cast<vtkVolumeCutField*>(this));
 }
 
 //------------------------------------------------------------------------------
 bool vtkVolumeCutField::ReadFile(const char* fileName)
 {
-  std::ifstream stream(fileName ? fileName : "", std::ios::binary);
-  if (!fileName || !stream)
+  vtkNew<vtkVolumeCutFieldFile> file;
+  file->SetFileName(fileName);
+  return file->Read(this);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
+{
+  if (!source || !source->Directory || !this->Directory)
   {
-    vtkErrorMacro("ReadFile: cannot open " << (fileName ? fileName : "(no file name)"));
+    vtkErrorMacro("ResampleFrom: both fields must be initialized");
     return false;
   }
-  char magic[sizeof(CutFieldMagic)];
-  int32_t version = 0;
-  if (!stream.read(magic, sizeof(magic)) || std::memcmp(magic, CutFieldMagic, sizeof(magic)) != 0 || !ReadValue(stream, version)
-      || version != CutFieldFileVersion)
+  // The target bricks that any allocated source brick can reach: elsewhere
+  // the source reads +BandWidth, which is what an unallocated brick holds.
+  std::vector<vtkIdType> targets;
+  const vtkIdType sourceCount = source->GetNumberOfAllocatedBricks();
+  for (vtkIdType n = 0; n < sourceCount; ++n)
   {
-    vtkErrorMacro("ReadFile: " << fileName << " is not a cut field file of version " << CutFieldFileVersion);
-    return false;
+    const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    const int b[3] = { static_cast<int>(brickId % source->BrickDimensions[0]),
+      static_cast<int>((brickId / source->BrickDimensions[0]) % source->BrickDimensions[1]),
+      static_cast<int>(brickId / (static_cast<vtkIdType>(source->BrickDimensions[0]) * source->BrickDimensions[1])) };
+    int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
+    int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
+    for (int corner = 0; corner < 8; ++corner)
+    {
+      // One source sample beyond the brick: interpolation reaches that far.
+      double index[3];
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        index[axis] = (corner >> axis) & 1 ? b[axis] * BrickSize + BrickSize : b[axis] * BrickSize - 1.0;
+      }
+      double ras[3];
+      Transform(source->SubIJKToRAS, index, ras);
+      double target[3];
+      Transform(this->RASToSubIJK, ras, target);
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        lower[axis] = std::min(lower[axis], static_cast<int>(std::floor(target[axis])));
+        upper[axis] = std::max(upper[axis], static_cast<int>(std::ceil(target[axis])));
+      }
+    }
+    int brickLower[3];
+    int brickUpper[3];
+    bool inside = true;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      brickLower[axis] = std::max(0, lower[axis]) / BrickSize;
+      brickUpper[axis] = std::min(this->Dimensions[axis] - 1, upper[axis]) / BrickSize;
+      inside &= upper[axis] >= 0 && lower[axis] < this->Dimensions[axis];
+    }
+    for (int k = brickLower[2]; inside && k <= brickUpper[2]; ++k)
+    {
+      for (int j = brickLower[1]; j <= brickUpper[1]; ++j)
+      {
+        for (int i = brickLower[0]; i <= brickUpper[0]; ++i)
+        {
+          targets.push_back((static_cast<vtkIdType>(k) * this->BrickDimensions[1] + j) * this->BrickDimensions[0] + i);
+        }
+      }
+    }
   }
-  int32_t anatomyDimensions[3];
-  int32_t factor = 0;
-  double matrixElements[16];
-  double quantum = 0.0;
-  int64_t count = 0;
-  bool ok = ReadValue(stream, anatomyDimensions[0]) && ReadValue(stream, anatomyDimensions[1]) && ReadValue(stream, anatomyDimensions[2])
-    && ReadValue(stream, factor);
-  for (double& element : matrixElements)
-  {
-    ok = ok && ReadValue(stream, element);
-  }
-  ok = ok && ReadValue(stream, quantum) && ReadValue(stream, count);
-  if (!ok)
-  {
-    vtkErrorMacro("ReadFile: " << fileName << " is truncated");
-    return false;
-  }
-  if (anatomyDimensions[0] == 0 && anatomyDimensions[1] == 0 && anatomyDimensions[2] == 0 && count == 0)
-  {
-    vtkNew<vtkVolumeCutField> empty;
-    this->DeepCopy(empty); // a field that was never initialized
-    return true;
-  }
-  vtkNew<vtkVolumeCutField> loaded;
-  vtkNew<vtkMatrix4x4> ijkToRas;
-  ijkToRas->DeepCopy(matrixElements);
-  const int dimensions[3] = { anatomyDimensions[0], anatomyDimensions[1], anatomyDimensions[2] };
-  if (!loaded->Initialize(dimensions, ijkToRas, factor))
-  {
-    vtkErrorMacro("ReadFile: " << fileName << " holds an invalid geometry");
-    return false;
-  }
-  const vtkIdType totalBricks = static_cast<vtkIdType>(loaded->BrickDimensions[0]) * loaded->BrickDimensions[1] * loaded->BrickDimensions[2];
-  if (std::abs(quantum - loaded->Quantum) > 1e-12 * std::max(1.0, loaded->Quantum) || count < 0 || count > totalBricks)
-  {
-    vtkErrorMacro("ReadFile: " << fileName << " is inconsistent (quantum or brick count)");
-    return false;
-  }
+  std::sort(targets.begin(), targets.end());
+  targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+
   BrickStates bricks;
-  for (int64_t n = 0; n < count; ++n)
+  const double inverseQuantum = 1.0 / this->Quantum;
+  for (vtkIdType brickId : targets)
   {
-    int64_t brickId = -1;
-    BrickValues values(SamplesPerBrick);
-    if (!ReadValue(stream, brickId) || !stream.read(reinterpret_cast<char*>(values.data()), SamplesPerBrick * sizeof(int16_t)))
+    const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
+      static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+    BrickValues values(SamplesPerBrick, Outside);
+    bool any = false;
+    for (int local = 0; local < SamplesPerBrick; ++local)
     {
-      vtkErrorMacro("ReadFile: " << fileName << " is truncated (brick " << n << " of " << count << ")");
-      return false;
+      const double index[3] = { double(b[0] * BrickSize + local % BrickSize), double(b[1] * BrickSize + (local / BrickSize) % BrickSize),
+        double(b[2] * BrickSize + local / (BrickSize * BrickSize)) };
+      double ras[3];
+      Transform(this->SubIJKToRAS, index, ras);
+      // Beyond the source's band its value says only "at least this far".
+      const double distance = source->GetSignedDistance(ras);
+      const double beyond = source->BandWidth - source->Quantum;
+      values[local] = distance >= beyond ? Outside
+        : distance <= -beyond            ? Inside
+                                         : static_cast<int16_t>(std::lround(std::min(this->BandWidth, std::max(-this->BandWidth, distance)) * inverseQuantum));
+      any |= values[local] != Outside;
     }
-    if (brickId < 0 || brickId >= totalBricks)
+    if (any)
     {
-      vtkErrorMacro("ReadFile: " << fileName << " names a brick outside the volume");
-      return false;
+      bricks[brickId] = std::move(values);
     }
-    bricks[static_cast<vtkIdType>(brickId)] = std::move(values);
   }
-  loaded->WriteBricks(bricks);
-  this->DeepCopy(loaded);
+  this->EndStroke();
+  this->UndoStack.clear();
+  this->RedoStack.clear();
+  this->UndoMemorySize = 0;
+  this->LastCapsule.Valid = false;
+  this->WriteBricks(bricks);
   return true;
 }
 

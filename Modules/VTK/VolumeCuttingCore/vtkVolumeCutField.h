@@ -36,6 +36,8 @@
 
 #include "vtkObject.h"
 #include "vtkType.h" // For vtkTypeUInt64
+#include "vtkSmartPointer.h"              // For the protection
+#include "vtkVolumeCutProtection.h"     // For the protection
 #include "vtkVolumeCuttingCoreExport.h" // For export macro
 
 #include <atomic>  // For the brick directory
@@ -44,7 +46,9 @@
 #include <memory>  // For std::unique_ptr
 #include <vector>  // For the brick directory
 
+class vtkFloatArray;
 class vtkIdList;
+class vtkIdTypeArray;
 class vtkImageData;
 class vtkMatrix4x4;
 class vtkPolyData;
@@ -186,17 +190,38 @@ public:
   ///@}
 
   /**
-   * Protect structures: anatomy voxels whose label is nonzero are never
-   * removed, whatever the tools do (tool "sensibility", Pflesser et al.).
-   * \a labels has the anatomy's dimensions (IJK geometry; the field's
-   * IJK-to-RAS applies) and one integer component: 0 for voxels a tool may
-   * cut, k > 0 for the k-th protected structure. Protection is exact to the
-   * voxel faces of the labels: the removed region becomes the tool's sweep
-   * minus the union of labelled voxel cubes, sharp edges included. Cuts
-   * already made are not changed. nullptr clears the protection. Returns
-   * false (and an error) if the dimensions differ.
+   * The shield: the structures a tool must not remove (tool "sensibility",
+   * Pflesser et al.). Give it label images and say which of their values are
+   * shielded (vtkVolumeCutProtection); it is built brick by brick where tools
+   * reach. The removed region becomes the tool's sweep minus the union of
+   * shielded voxel cubes, sharp edges included, and a tool entering a shielded
+   * structure is reported as a contact. Cuts already made are not changed by
+   * a new shield. Always present; it follows the field's geometry and is
+   * emptied by Initialize. Change it only while no stroke is being written.
+   */
+  vtkVolumeCutProtection* GetProtection() { return this->Protection; }
+
+  /**
+   * Shield structures given as one label image with the anatomy's dimensions
+   * (IJK geometry; one integer component): 0 for voxels a tool may cut, k > 0
+   * for the k-th protected structure (labels above 255 are reported as 255).
+   * Replaces the protection's images and table; nullptr clears them. Returns
+   * false (and an error), changing nothing, if the dimensions differ.
    */
   bool SetProtectedLabels(vtkImageData* labels);
+
+  /**
+   * Replace this field's samples by another field's cut resampled onto this
+   * field's grid (after Initialize with the new grid or factor): every sample
+   * takes the other field's signed distance at its position, so the removed
+   * region is kept to within the coarser grid's accuracy. The undo history
+   * starts empty. Returns false (and an error), changing nothing, if either
+   * field is not initialized.
+   */
+  bool ResampleFrom(vtkVolumeCutField* source);
+
+  /// Includes changes of the shield, which change what exports report.
+  vtkMTimeType GetMTime() override;
 
   ///@{
   /**
@@ -230,7 +255,10 @@ public:
    * Removed fraction (0..1) of the sub-voxel (i, j, k): the partial-volume
    * (filtered) value of the removed region. Cells the surface crosses are
    * integrated over 4^3 points of the reconstructed distance, each with a
-   * ramp as wide as a sub-cell's extent along the surface normal.
+   * ramp as wide as a sub-cell's extent along the surface normal. A sample
+   * inside a shielded voxel that the field did not remove (its distance is
+   * not negative) is exactly 0: the shield's voxel cube is outside the removed
+   * region, though the ramp of the cut surface on its face would spill into it.
    */
   double GetRemovedFraction(int i, int j, int k) const;
 
@@ -254,6 +282,14 @@ public:
    * node gives IJK-to-RAS), the mean of its sub-voxels' removed fractions.
    */
   void ExportRemovedFraction(vtkImageData* anatomyFraction) const;
+
+  /**
+   * The same fractions for only the anatomy voxels with a removed fraction
+   * above zero: their linear index (i + dims[0] * (j + dims[1] * k)) and
+   * fraction, in the order of the allocated bricks. The cost follows the
+   * cut, not the volume: for per-segment volumes on patient-scale scans.
+   */
+  void ExportRemovedVoxels(vtkIdTypeArray* anatomyVoxelIds, vtkFloatArray* fractions) const;
 
   /**
    * The boundary of the removed region as a closed triangle surface in RAS
@@ -311,7 +347,6 @@ protected:
   ~vtkVolumeCutField() override;
 
   struct Brick;
-  struct ProtectionBrick;
 
 public:
   /// Internal: a tool sweep's reach and distances, written row by row or a
@@ -353,7 +388,7 @@ protected:
   void QuantizeDistances(const float* distances, int count, Operation operation, int16_t* quantized) const;
   /// Merges a run of quantised tool distances into a brick (null: not
   /// allocated) at sample rowStart; records contacts with protected samples.
-  bool MergeSegment(const Brick* brick, const ProtectionBrick* protection, const int brickIndex[3], const int16_t* quantized, int rowStart,
+  bool MergeSegment(const Brick* brick, const vtkVolumeCutProtection::Brick* protection, const int brickIndex[3], const int16_t* quantized, int rowStart,
     int count, Operation operation, const DistanceSource& source, int16_t* merged);
   /// Stores the changed runs of merged (a whole brick's layout) under the
   /// brick's seqlock, remembering the brick for undo first.
@@ -366,11 +401,15 @@ protected:
   void WriteBricks(const BrickStates& bricks);
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
-  /// Calls visit(i, j, k) for every sample of every allocated brick.
+  /// The removed fraction of a sample from the field alone (no shield).
+  double ComputeRemovedFraction(int i, int j, int k) const;
+  /// Calls visit(i, j, k, shielded) for every sample of every allocated
+  /// brick; shielded: the sample's anatomy voxel is in a shielded structure.
   template <typename Visitor>
-  void ForEachAllocatedSample(Visitor&& visit) const;
+  void ForEachAllocatedSampleWithShield(Visitor&& visit) const;
   void Reset();
-  const ProtectionBrick* GetProtectionBrick(vtkIdType brickId) const;
+  /// The shield of a brick (built on first reach), nullptr where the tool cuts freely.
+  const vtkVolumeCutProtection::Brick* GetProtectionBrick(vtkIdType brickId);
 
   int Dimensions[3] = { 0, 0, 0 };
   int BrickDimensions[3] = { 0, 0, 0 };
@@ -391,6 +430,7 @@ protected:
     double End[3] = { 0.0, 0.0, 0.0 };
     double Radius = 0.0;
     vtkTypeUInt64 Stamp = 0;
+    vtkMTimeType ProtectionTime = 0;
   };
   CapsuleContinuation LastCapsule;
   double MaximumStrokeLength = 50.0;
@@ -406,9 +446,7 @@ protected:
   std::unique_ptr<std::atomic<vtkIdType>[]> AllocatedBrickIds;
   std::atomic<vtkIdType> NumberOfAllocatedBricks{ 0 };
   std::vector<std::unique_ptr<Brick>> OwnedBricks;
-  // Protection: per brick near or inside protected voxels, the signed
-  // distance to their union and the nearest structure's label.
-  std::vector<std::unique_ptr<ProtectionBrick>> ProtectionBricks;
+  vtkSmartPointer<vtkVolumeCutProtection> Protection;
   double MaximumContactDepth = 0.0;
   int ContactLabel = 0;
   double ContactPosition[3] = { 0.0, 0.0, 0.0 };
@@ -430,6 +468,7 @@ protected:
 
 private:
   friend class vtkVolumeCutMaterialRemoval;
+  friend class vtkVolumeCutFieldFile;
   vtkVolumeCutField(const vtkVolumeCutField&) = delete;
   void operator=(const vtkVolumeCutField&) = delete;
 };

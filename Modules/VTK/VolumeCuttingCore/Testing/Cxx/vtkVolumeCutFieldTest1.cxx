@@ -541,6 +541,58 @@ int TestProtectedVoxelsAreNeverRemoved()
   TESTING_OUTPUT_ASSERT_ERRORS_END();
   return EXIT_SUCCESS;
 }
+
+// A cut is kept when the grid changes: resampled onto a finer sub-voxel
+// factor and onto a cropped grid, the removed volume and the surface stay
+// where they were.
+int TestResampleKeepsTheCut()
+{
+  const int dims[3] = { 40, 40, 30 };
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  MakeObliqueGrid(ijkToRas);
+  vtkNew<vtkVolumeCutField> field;
+  field->Initialize(dims, ijkToRas, 2);
+  double centerIndex[4] = { 20.0, 19.0, 14.0, 1.0 };
+  double center[4];
+  ijkToRas->MultiplyPoint(centerIndex, center);
+  const double radius = 3.0;
+  CHECK_BOOL(field->CutCapsule(center, center, radius), true);
+  const double exact = 4.0 / 3.0 * Pi * radius * radius * radius;
+
+  vtkNew<vtkVolumeCutField> finer;
+  finer->Initialize(dims, ijkToRas, 4);
+  CHECK_BOOL(finer->ResampleFrom(field), true);
+  CHECK_INT(finer->GetNumberOfUndoSteps(), 0);
+  const double finerError = std::abs(finer->ComputeRemovedVolume() - exact) / exact;
+  const SurfaceError finerSurface = SphereSurfaceError(finer, center, radius, 0.4);
+
+  // Cropped: 8 voxels fewer on each low side, the same physical voxels.
+  const int croppedDims[3] = { 32, 32, 22 };
+  vtkNew<vtkMatrix4x4> croppedToRas;
+  croppedToRas->DeepCopy(ijkToRas);
+  double shifted[4] = { 8.0, 8.0, 8.0, 1.0 };
+  double origin[4];
+  ijkToRas->MultiplyPoint(shifted, origin);
+  for (int row = 0; row < 3; ++row)
+  {
+    croppedToRas->SetElement(row, 3, origin[row]);
+  }
+  vtkNew<vtkVolumeCutField> cropped;
+  cropped->Initialize(croppedDims, croppedToRas, 2);
+  CHECK_BOOL(cropped->ResampleFrom(field), true);
+  const double croppedDifference = std::abs(cropped->ComputeRemovedVolume() - field->ComputeRemovedVolume());
+  std::cout << "resampled cut: factor 2 -> 4 volume error " << 100 * finerError << " %, surface RMS " << finerSurface.Rms << " max " << finerSurface.Max
+            << " voxel; cropped grid volume difference " << croppedDifference << " mm^3" << std::endl;
+  CHECK_BOOL(finerError < 0.005, true);
+  CHECK_BOOL(finerSurface.Max < 0.02, true);
+  CHECK_BOOL(croppedDifference < 1e-6 * exact, true);
+
+  vtkNew<vtkVolumeCutField> uninitialized;
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(uninitialized->ResampleFrom(field), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  return EXIT_SUCCESS;
+}
 } // namespace
 
 int vtkVolumeCutFieldTest1(int, char*[])
@@ -555,5 +607,6 @@ int vtkVolumeCutFieldTest1(int, char*[])
   CHECK_EXIT_SUCCESS(TestBadInputKeepsTheCut());
   CHECK_EXIT_SUCCESS(TestExportAndMemory());
   CHECK_EXIT_SUCCESS(TestProtectedVoxelsAreNeverRemoved());
+  CHECK_EXIT_SUCCESS(TestResampleKeepsTheCut());
   return EXIT_SUCCESS;
 }

@@ -1,0 +1,438 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutProtection.h"
+#include "vtkVolumeCutProtectionBrick.h"
+
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+vtkStandardNewMacro(vtkVolumeCutProtection);
+
+namespace
+{
+constexpr int BrickSize = vtkVolumeCutField::BrickSize;
+
+/// Reads the labels of one image's voxels inside the box into the box's label
+/// array, keeping the highest label where several structures overlap.
+template <typename T>
+void ReadLabels(const T* first, const vtkIdType increments[3], const int count[3], const std::vector<uint8_t>& table, uint8_t* labels,
+  const int labelIncrements[3])
+{
+  const vtkIdType tableSize = static_cast<vtkIdType>(table.size());
+  for (int z = 0; z < count[2]; ++z)
+  {
+    for (int y = 0; y < count[1]; ++y)
+    {
+      const T* voxel = first + z * increments[2] + y * increments[1];
+      uint8_t* label = labels + z * labelIncrements[2] + y * labelIncrements[1];
+      for (int x = 0; x < count[0]; ++x, voxel += increments[0], ++label)
+      {
+        const vtkIdType value = static_cast<vtkIdType>(*voxel);
+        if (value > 0 && value < tableSize)
+        {
+          *label = std::max(*label, table[value]);
+        }
+      }
+    }
+  }
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkVolumeCutProtection::vtkVolumeCutProtection() = default;
+
+//------------------------------------------------------------------------------
+vtkVolumeCutProtection::~vtkVolumeCutProtection() = default;
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutProtection::AddLabelImage(vtkImageData* image)
+{
+  vtkDataArray* scalars = image ? image->GetPointData()->GetScalars() : nullptr;
+  if (!scalars || !scalars->IsIntegral() || scalars->GetNumberOfComponents() != 1)
+  {
+    vtkErrorMacro("AddLabelImage: a label image needs one integer scalar component");
+    return -1;
+  }
+  LabelImage entry;
+  entry.Image = image;
+  this->LabelImages.push_back(std::move(entry));
+  this->ClearBricks();
+  this->Modified();
+  return static_cast<int>(this->LabelImages.size()) - 1;
+}
+
+//------------------------------------------------------------------------------
+vtkImageData* vtkVolumeCutProtection::GetLabelImage(int index) const
+{
+  return index >= 0 && index < this->GetNumberOfLabelImages() ? this->LabelImages[index].Image.GetPointer() : nullptr;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::RemoveAllLabelImages()
+{
+  if (this->LabelImages.empty())
+  {
+    return;
+  }
+  this->LabelImages.clear();
+  this->ClearBricks();
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutProtection::SetShieldLabel(int imageIndex, int value, int label)
+{
+  if (imageIndex < 0 || imageIndex >= this->GetNumberOfLabelImages())
+  {
+    vtkErrorMacro("SetShieldLabel: there is no label image " << imageIndex);
+    return false;
+  }
+  if (value < 1 || value > MaximumLabelValue || label < 0 || label > 255)
+  {
+    vtkErrorMacro("SetShieldLabel: value " << value << " (1.." << MaximumLabelValue << ") or structure label " << label << " (0..255) is out of range");
+    return false;
+  }
+  std::vector<uint8_t>& table = this->LabelImages[imageIndex].Labels;
+  if (static_cast<int>(table.size()) <= value)
+  {
+    if (label == 0)
+    {
+      return true;
+    }
+    table.resize(static_cast<size_t>(value) + 1, 0);
+  }
+  if (table[value] == label)
+  {
+    return true;
+  }
+  table[value] = static_cast<uint8_t>(label);
+  this->ClearBricks();
+  this->Modified();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::RemoveAllShieldLabels()
+{
+  if (!this->HasShieldedLabels())
+  {
+    return;
+  }
+  for (LabelImage& entry : this->LabelImages)
+  {
+    entry.Labels.clear();
+  }
+  this->ClearBricks();
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutProtection::HasShieldedLabels() const
+{
+  for (const LabelImage& entry : this->LabelImages)
+  {
+    if (std::any_of(entry.Labels.begin(), entry.Labels.end(), [](uint8_t label) { return label != 0; }))
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::GetShieldLabels(const int voxelLower[3], const int voxelUpper[3], uint8_t* labels) const
+{
+  const int size[3] = { voxelUpper[0] - voxelLower[0] + 1, voxelUpper[1] - voxelLower[1] + 1, voxelUpper[2] - voxelLower[2] + 1 };
+  if (size[0] <= 0 || size[1] <= 0 || size[2] <= 0)
+  {
+    return;
+  }
+  std::fill(labels, labels + static_cast<size_t>(size[0]) * size[1] * size[2], uint8_t(0));
+  const int labelIncrements[3] = { 1, size[0], size[0] * size[1] };
+  for (const LabelImage& entry : this->LabelImages)
+  {
+    if (entry.Labels.empty())
+    {
+      continue;
+    }
+    vtkImageData* image = entry.Image;
+    int extent[6];
+    image->GetExtent(extent);
+    int lower[3];
+    int count[3];
+    bool empty = false;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      // Only the anatomy's voxels can be shielded.
+      lower[axis] = std::max({ voxelLower[axis], extent[2 * axis], 0 });
+      const int upper = std::min({ voxelUpper[axis], extent[2 * axis + 1], this->AnatomyDimensions[axis] - 1 });
+      count[axis] = upper - lower[axis] + 1;
+      empty |= count[axis] <= 0;
+    }
+    if (empty)
+    {
+      continue;
+    }
+    vtkIdType increments[3];
+    image->GetIncrements(increments);
+    void* first = image->GetScalarPointer(lower[0], lower[1], lower[2]);
+    uint8_t* target = labels + (lower[0] - voxelLower[0]) * labelIncrements[0] + (lower[1] - voxelLower[1]) * labelIncrements[1] +
+      (lower[2] - voxelLower[2]) * labelIncrements[2];
+    switch (image->GetScalarType())
+    {
+      vtkTemplateMacro(ReadLabels(static_cast<const VTK_TT*>(first), increments, count, entry.Labels, target, labelIncrements));
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkVolumeCutProtection::GetShieldLabel(int i, int j, int k) const
+{
+  const int voxel[3] = { i, j, k };
+  uint8_t label = 0;
+  this->GetShieldLabels(voxel, voxel, &label);
+  return label;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::SetFieldGeometry(
+  const int anatomyDimensions[3], int subVoxelFactor, const double anatomySpacing[3], double bandWidth, double quantum)
+{
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    this->AnatomyDimensions[axis] = anatomyDimensions[axis];
+    this->AnatomySpacing[axis] = anatomySpacing[axis];
+    this->BrickDimensions[axis] = (anatomyDimensions[axis] * subVoxelFactor + BrickSize - 1) / BrickSize;
+    // Voxels farther than the band along an axis cannot be within the band.
+    this->Reach[axis] = static_cast<int>(std::ceil(bandWidth / anatomySpacing[axis])) + 1;
+  }
+  this->SubVoxelFactor = subVoxelFactor;
+  this->BandWidth = bandWidth;
+  this->Quantum = quantum;
+  this->ClearBricks();
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::ClearBricks()
+{
+  this->Bricks.clear();
+  this->NumberOfShieldBricks = 0;
+}
+
+//------------------------------------------------------------------------------
+const vtkVolumeCutProtection::Brick* vtkVolumeCutProtection::GetBrick(vtkIdType brickId)
+{
+  if (this->SubVoxelFactor < 1 || this->LabelImages.empty())
+  {
+    return nullptr;
+  }
+  auto found = this->Bricks.find(brickId);
+  if (found != this->Bricks.end())
+  {
+    return found->second.get();
+  }
+  std::unique_ptr<Brick> built = this->BuildBrick(brickId);
+  const Brick* brick = built.get();
+  this->NumberOfShieldBricks += brick != nullptr;
+  this->Bricks.emplace(brickId, std::move(built));
+  return brick;
+}
+
+//------------------------------------------------------------------------------
+std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBrick(vtkIdType brickId) const
+{
+  const int f = this->SubVoxelFactor;
+  const int brickIndex[3] = { static_cast<int>(brickId % this->BrickDimensions[0]),
+    static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
+    static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+  // Per axis: each sample's continuous anatomy index, the voxel it lies in,
+  // and the box of voxels within the band of any sample.
+  double position[3][BrickSize];
+  int own[3][BrickSize];
+  int lower[3];
+  int upper[3];
+  int size[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    for (int n = 0; n < BrickSize; ++n)
+    {
+      position[axis][n] = (brickIndex[axis] * BrickSize + n + 0.5) / f - 0.5;
+      own[axis][n] = static_cast<int>(std::lround(position[axis][n]));
+    }
+    lower[axis] = own[axis][0] - this->Reach[axis];
+    upper[axis] = own[axis][BrickSize - 1] + this->Reach[axis];
+    size[axis] = upper[axis] - lower[axis] + 1;
+  }
+  const size_t blockCount = static_cast<size_t>(size[0]) * size[1] * size[2];
+  std::vector<uint8_t> labels(blockCount);
+  this->GetShieldLabels(lower, upper, labels.data());
+  if (std::none_of(labels.begin(), labels.end(), [](uint8_t label) { return label != 0; }))
+  {
+    return nullptr; // nothing shielded within the band: the tool cuts freely
+  }
+  auto labelAt = [&](int x, int y, int z) { return labels[(static_cast<size_t>(z) * size[1] + y) * size[0] + x]; };
+
+  // Squared distance along one axis from a sample to a voxel cube (cubes
+  // span the voxel's index +-0.5).
+  std::vector<double> along[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    along[axis].resize(static_cast<size_t>(BrickSize) * size[axis]);
+    for (int n = 0; n < BrickSize; ++n)
+    {
+      for (int c = 0; c < size[axis]; ++c)
+      {
+        const double excess = std::max(0.0, std::abs(position[axis][n] - (lower[axis] + c)) - 0.5) * this->AnatomySpacing[axis];
+        along[axis][static_cast<size_t>(n) * size[axis] + c] = excess * excess;
+      }
+    }
+  }
+
+  // The distance to a union of cubes is a minimum over a product of axes, so
+  // it separates: min over x, then over y, then over z, each with its own
+  // sample positions (Saito and Toriwaki's decomposition on the cubes'
+  // per-axis excess). Once for the shielded voxels (seen from samples
+  // outside them), once for the free ones (from samples inside).
+  constexpr double Far = std::numeric_limits<double>::max();
+  std::vector<double> passX(static_cast<size_t>(size[2]) * size[1] * BrickSize);
+  std::vector<uint8_t> labelX(passX.size());
+  std::vector<double> passY(static_cast<size_t>(size[2]) * BrickSize * BrickSize);
+  std::vector<uint8_t> labelY(passY.size());
+  double nearest[2][Brick::Samples];
+  uint8_t nearestLabel[Brick::Samples];
+  for (int set = 0; set < 2; ++set)
+  {
+    const bool towardShielded = set == 0;
+    for (int z = 0; z < size[2]; ++z)
+    {
+      for (int y = 0; y < size[1]; ++y)
+      {
+        for (int n = 0; n < BrickSize; ++n)
+        {
+          double best = Far;
+          uint8_t bestLabel = 0;
+          const double* cost = &along[0][static_cast<size_t>(n) * size[0]];
+          for (int x = 0; x < size[0]; ++x)
+          {
+            const uint8_t label = labelAt(x, y, z);
+            if ((label != 0) == towardShielded && cost[x] < best)
+            {
+              best = cost[x];
+              bestLabel = label;
+            }
+          }
+          const size_t index = (static_cast<size_t>(z) * size[1] + y) * BrickSize + n;
+          passX[index] = best;
+          labelX[index] = bestLabel;
+        }
+      }
+    }
+    for (int z = 0; z < size[2]; ++z)
+    {
+      for (int m = 0; m < BrickSize; ++m)
+      {
+        const double* cost = &along[1][static_cast<size_t>(m) * size[1]];
+        for (int n = 0; n < BrickSize; ++n)
+        {
+          double best = Far;
+          uint8_t bestLabel = 0;
+          for (int y = 0; y < size[1]; ++y)
+          {
+            const size_t from = (static_cast<size_t>(z) * size[1] + y) * BrickSize + n;
+            if (passX[from] < Far && cost[y] + passX[from] < best)
+            {
+              best = cost[y] + passX[from];
+              bestLabel = labelX[from];
+            }
+          }
+          const size_t index = (static_cast<size_t>(z) * BrickSize + m) * BrickSize + n;
+          passY[index] = best;
+          labelY[index] = bestLabel;
+        }
+      }
+    }
+    for (int p = 0; p < BrickSize; ++p)
+    {
+      const double* cost = &along[2][static_cast<size_t>(p) * size[2]];
+      for (int m = 0; m < BrickSize; ++m)
+      {
+        for (int n = 0; n < BrickSize; ++n)
+        {
+          double best = Far;
+          uint8_t bestLabel = 0;
+          for (int z = 0; z < size[2]; ++z)
+          {
+            const size_t from = (static_cast<size_t>(z) * BrickSize + m) * BrickSize + n;
+            if (passY[from] < Far && cost[z] + passY[from] < best)
+            {
+              best = cost[z] + passY[from];
+              bestLabel = labelY[from];
+            }
+          }
+          const int local = (p * BrickSize + m) * BrickSize + n;
+          nearest[set][local] = best;
+          if (towardShielded)
+          {
+            nearestLabel[local] = bestLabel;
+          }
+        }
+      }
+    }
+  }
+
+  std::unique_ptr<Brick> brick(new Brick);
+  const double inverseQuantum = 1.0 / this->Quantum;
+  bool useful = false;
+  for (int p = 0; p < BrickSize; ++p)
+  {
+    for (int m = 0; m < BrickSize; ++m)
+    {
+      for (int n = 0; n < BrickSize; ++n)
+      {
+        const int local = (p * BrickSize + m) * BrickSize + n;
+        const uint8_t ownLabel = labelAt(own[0][n] - lower[0], own[1][m] - lower[1], own[2][p] - lower[2]);
+        // Inside: the distance to the nearest free cube; outside: to the
+        // nearest shielded one. Voxels beyond the box are beyond the band.
+        const double squared = nearest[ownLabel != 0 ? 1 : 0][local];
+        const double distance = squared == Far ? this->BandWidth : std::min(this->BandWidth, std::sqrt(squared));
+        const double signedDistance = ownLabel != 0 ? -distance : distance;
+        brick->Distance[local] = static_cast<int16_t>(std::lround(signedDistance * inverseQuantum));
+        brick->Label[local] = ownLabel != 0 ? ownLabel : nearestLabel[local];
+        useful |= signedDistance < this->BandWidth;
+      }
+    }
+  }
+  return useful ? std::move(brick) : nullptr;
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutProtection::GetMemorySize() const
+{
+  size_t bytes = static_cast<size_t>(this->NumberOfShieldBricks) * sizeof(Brick);
+  // The hash table's nodes and buckets.
+  bytes += this->Bricks.size() * (sizeof(vtkIdType) + sizeof(std::unique_ptr<Brick>) + 2 * sizeof(void*));
+  bytes += this->Bricks.bucket_count() * sizeof(void*);
+  for (const LabelImage& entry : this->LabelImages)
+  {
+    bytes += entry.Labels.capacity();
+  }
+  return bytes;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "LabelImages: " << this->LabelImages.size() << "\n";
+  os << indent << "HasShieldedLabels: " << (this->HasShieldedLabels() ? "yes" : "no") << "\n";
+  os << indent << "Reach (voxels): " << this->Reach[0] << " " << this->Reach[1] << " " << this->Reach[2] << "\n";
+  os << indent << "BuiltBricks: " << this->GetNumberOfBuiltBricks() << " (" << this->NumberOfShieldBricks << " with a shield)\n";
+  os << indent << "MemorySize: " << this->GetMemorySize() << " bytes\n";
+}

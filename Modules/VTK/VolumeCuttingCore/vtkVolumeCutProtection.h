@@ -1,0 +1,152 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+/**
+ * @class   vtkVolumeCutProtection
+ * @brief   The shield of a cut field: the structures a tool must not remove.
+ *
+ * Tool "sensibility" (Pflesser et al., 2002): a tool removes only what it may
+ * cut; the anatomy voxels of every other structure are shielded. The shield
+ * is the signed distance (mm, negative inside) to the union of the shielded
+ * voxel cubes, sampled at the cut field's sub-voxel centres within its band;
+ * the writer cuts max(tool, -shield), so creases against a shielded structure
+ * are exact to the voxel faces.
+ *
+ * Where the shielded voxels are is read from label images on the anatomy's
+ * voxel grid: Slicer's segmentation layers, in which several segments share
+ * one image with different values. Which value of which image is shielded,
+ * and as which structure, is a small table, so that changing roles costs
+ * nothing in proportion to the volume.
+ *
+ * The shield is built a brick at a time, the first time a tool reaches the
+ * brick, from the labels within the band around it (a separable minimum over
+ * the three axes: exact, not an approximation of the distance to the voxel
+ * cubes). Nothing is computed for the parts of a patient-scale scan that no
+ * tool comes near, and a role change only forgets the bricks built so far.
+ *
+ * Threads: the images and the table are changed, and bricks are built, by the
+ * field's writer (or while no writer runs); GetShieldLabel may be called by
+ * readers while the writer cuts, provided the images and the table do not change.
+ */
+
+#ifndef vtkVolumeCutProtection_h
+#define vtkVolumeCutProtection_h
+
+#include "vtkObject.h"
+#include "vtkSmartPointer.h"            // For the label images
+#include "vtkVolumeCuttingCoreExport.h" // For export macro
+
+#include <cstdint>       // For uint8_t
+#include <memory>        // For std::unique_ptr
+#include <unordered_map> // For the built bricks
+#include <vector>        // For the label images
+
+class vtkImageData;
+
+class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutProtection : public vtkObject
+{
+public:
+  static vtkVolumeCutProtection* New();
+  vtkTypeMacro(vtkVolumeCutProtection, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  /// The largest value a label image may use for a shielded segment.
+  static constexpr int MaximumLabelValue = 65535;
+
+  /**
+   * Add an integer image on the anatomy's voxel grid whose values name
+   * segments (0: none). Its extent says which anatomy voxels it covers
+   * (voxels outside hold no segment); origin, spacing and direction are not
+   * read. Returns its index for SetShieldLabel, or -1 (and an error) for an
+   * image without one integer scalar component.
+   */
+  int AddLabelImage(vtkImageData* image);
+  int GetNumberOfLabelImages() const { return static_cast<int>(this->LabelImages.size()); }
+  vtkImageData* GetLabelImage(int index) const;
+  /// Remove every label image and the whole table.
+  void RemoveAllLabelImages();
+
+  /**
+   * Shield the voxels that hold value in the label image as structure label
+   * (1..255; 0 unshields them). Where shielded voxels of several structures
+   * overlap, the highest label names the voxel. Returns false (and an error),
+   * changing nothing, for an unknown image, a value outside 1..MaximumLabelValue
+   * or a label outside 0..255.
+   */
+  bool SetShieldLabel(int imageIndex, int value, int label);
+  /// Unshield everything, keeping the images.
+  void RemoveAllShieldLabels();
+  /// Whether any value of any image is shielded.
+  bool HasShieldedLabels() const;
+
+  /**
+   * The structure label (0: not shielded) of anatomy voxel (i, j, k); voxels
+   * outside the anatomy are not shielded.
+   */
+  int GetShieldLabel(int i, int j, int k) const;
+
+  /**
+   * Labels of the anatomy voxels of a box (inclusive bounds, any part may lie
+   * outside the anatomy: those voxels are 0), x fastest, into labels.
+   */
+  void GetShieldLabels(const int voxelLower[3], const int voxelUpper[3], uint8_t* labels) const;
+
+  /**
+   * Geometry of the cut field the shield is sampled for: anatomy dimensions,
+   * sub-voxel factor, the anatomy's spacing along its three grid axes, and
+   * the field's band and quantum. Set by vtkVolumeCutField; forgets the
+   * bricks built so far.
+   */
+  void SetFieldGeometry(const int anatomyDimensions[3], int subVoxelFactor, const double anatomySpacing[3], double bandWidth, double quantum);
+
+  /// Internal: the shield within one brick of the field (vtkVolumeCutProtectionBrick.h).
+  struct Brick;
+
+  /**
+   * The shield within a brick of the field, built on first request; nullptr
+   * where no shielded voxel lies within the band (the tool cuts freely).
+   */
+  const Brick* GetBrick(vtkIdType brickId);
+
+  ///@{
+  /// Bricks built so far (those with a shield and those found free) and the memory they use.
+  vtkIdType GetNumberOfBuiltBricks() const { return static_cast<vtkIdType>(this->Bricks.size()); }
+  vtkIdType GetNumberOfShieldBricks() const { return this->NumberOfShieldBricks; }
+  size_t GetMemorySize() const;
+  ///@}
+
+  /// Forget the bricks built so far (they are built again when reached).
+  void ClearBricks();
+
+protected:
+  vtkVolumeCutProtection();
+  ~vtkVolumeCutProtection() override;
+
+  /// Builds the shield of one brick; nullptr where it would be free.
+  std::unique_ptr<Brick> BuildBrick(vtkIdType brickId) const;
+
+  struct LabelImage
+  {
+    vtkSmartPointer<vtkImageData> Image;
+    /// Structure label by voxel value (0: not shielded).
+    std::vector<uint8_t> Labels;
+  };
+  std::vector<LabelImage> LabelImages;
+
+  int AnatomyDimensions[3] = { 0, 0, 0 };
+  int BrickDimensions[3] = { 0, 0, 0 };
+  int SubVoxelFactor = 0;
+  double AnatomySpacing[3] = { 1.0, 1.0, 1.0 };
+  double BandWidth = 1.0;
+  double Quantum = 1.0;
+  /// Anatomy voxels within the band of a sample, along each axis.
+  int Reach[3] = { 1, 1, 1 };
+
+  std::unordered_map<vtkIdType, std::unique_ptr<Brick>> Bricks;
+  vtkIdType NumberOfShieldBricks = 0;
+
+private:
+  vtkVolumeCutProtection(const vtkVolumeCutProtection&) = delete;
+  void operator=(const vtkVolumeCutProtection&) = delete;
+};
+
+#endif
