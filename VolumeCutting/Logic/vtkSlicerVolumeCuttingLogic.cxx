@@ -14,6 +14,7 @@
 #include "vtkImageBoneSegmentation.h"
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkMRMLVolumeCutStorageNode.h"
+#include "vtkSlicerVolumeCuttingSegmentLayers.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutMaterialRemoval.h"
 
@@ -25,6 +26,7 @@
 #include <vtkMRMLScene.h>
 #include <vtkMRMLSegmentationDisplayNode.h>
 #include <vtkMRMLSegmentationNode.h>
+#include <vtkMRMLTableNode.h>
 
 // SegmentationCore includes
 #include <vtkBinaryLabelmapToClosedSurfaceConversionRule.h>
@@ -44,6 +46,10 @@
 // VTK includes
 #include <vtkCommand.h>
 #include <vtkFloatArray.h>
+#include <vtkIdTypeArray.h>
+#include <vtkStringArray.h>
+#include <vtkDoubleArray.h>
+#include <vtkTable.h>
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
@@ -54,7 +60,11 @@
 
 // STD includes
 #include <cmath>
+#include <algorithm>
+#include <chrono>
 #include <cstring>
+#include <ctime>
+#include <iomanip>
 #include <sstream>
 
 vtkStandardNewMacro(vtkSlicerVolumeCuttingLogic);
@@ -337,9 +347,7 @@ void vtkSlicerVolumeCuttingLogic::SetMRMLSceneInternal(vtkMRMLScene* newScene)
   events->InsertNextValue(vtkMRMLScene::NodeRemovedEvent);
   events->InsertNextValue(vtkMRMLScene::EndCloseEvent);
   this->SetAndObserveMRMLSceneEventsInternal(newScene, events);
-  this->ProtectionSources.clear();
-  this->MaterialRemovals.clear();
-  this->RemovedFractions.clear();
+  this->ForgetAllNodes();
 }
 
 //----------------------------------------------------------------------------
@@ -347,18 +355,101 @@ void vtkSlicerVolumeCuttingLogic::OnMRMLSceneNodeRemoved(vtkMRMLNode* node)
 {
   if (node && node->GetID())
   {
-    this->ProtectionSources.erase(node->GetID());
-    this->MaterialRemovals.erase(node->GetID());
-    this->RemovedFractions.erase(node->GetID());
+    this->ForgetNode(node->GetID());
   }
 }
 
 //----------------------------------------------------------------------------
 void vtkSlicerVolumeCuttingLogic::OnMRMLSceneEndClose()
 {
+  this->ForgetAllNodes();
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::ForgetNode(const std::string& nodeId)
+{
+  this->ProtectionSources.erase(nodeId);
+  this->MaterialRemovals.erase(nodeId);
+  this->RemovedFractions.erase(nodeId);
+  this->RemovedVoxels.erase(nodeId);
+  this->SegmentLayers.erase(nodeId);
+  this->ShieldedSegments.erase(nodeId);
+  this->ReportedContactDepths.erase(nodeId);
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::ForgetAllNodes()
+{
   this->ProtectionSources.clear();
   this->MaterialRemovals.clear();
   this->RemovedFractions.clear();
+  this->RemovedVoxels.clear();
+  this->SegmentLayers.clear();
+  this->ShieldedSegments.clear();
+  this->ReportedContactDepths.clear();
+}
+
+//----------------------------------------------------------------------------
+std::string vtkSlicerVolumeCuttingLogic::DescribeGridChange(vtkVolumeCutField* field, const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int factor)
+{
+  std::ostringstream change;
+  const int fieldFactor = field->GetSubVoxelFactor();
+  if (fieldFactor < 1)
+  {
+    return "the cut field is empty";
+  }
+  if (fieldFactor != factor)
+  {
+    change << "sub-voxel factor " << fieldFactor << " -> " << factor << "; ";
+  }
+  const int* fieldDimensions = field->GetDimensions();
+  if (fieldDimensions[0] != anatomyDimensions[0] * fieldFactor || fieldDimensions[1] != anatomyDimensions[1] * fieldFactor ||
+    fieldDimensions[2] != anatomyDimensions[2] * fieldFactor)
+  {
+    change << "dimensions " << fieldDimensions[0] / fieldFactor << "x" << fieldDimensions[1] / fieldFactor << "x" << fieldDimensions[2] / fieldFactor
+           << " -> " << anatomyDimensions[0] << "x" << anatomyDimensions[1] << "x" << anatomyDimensions[2] << "; ";
+  }
+  // The field's anatomy grid, rebuilt from its sub-voxel grid.
+  vtkNew<vtkMatrix4x4> subToRas;
+  field->GetSubVoxelIJKToRAS(subToRas);
+  double spacing = std::numeric_limits<double>::max();
+  bool axesDiffer = false;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    double length2 = 0.0;
+    double difference2 = 0.0;
+    for (int row = 0; row < 3; ++row)
+    {
+      const double a = anatomyIJKToRAS->GetElement(row, axis);
+      const double d = subToRas->GetElement(row, axis) * fieldFactor - a;
+      length2 += a * a;
+      difference2 += d * d;
+    }
+    spacing = std::min(spacing, std::sqrt(length2));
+    axesDiffer |= !(difference2 <= 1e-6 * length2);
+  }
+  if (axesDiffer)
+  {
+    change << "voxel spacing or axes; ";
+  }
+  double shift2 = 0.0;
+  for (int row = 0; row < 3; ++row)
+  {
+    // Sub-voxel 0 sits (0.5 / f - 0.5) anatomy voxels from anatomy voxel 0.
+    double expected = anatomyIJKToRAS->GetElement(row, 3);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      expected += anatomyIJKToRAS->GetElement(row, axis) * (0.5 / fieldFactor - 0.5);
+    }
+    const double d = subToRas->GetElement(row, 3) - expected;
+    shift2 += d * d;
+  }
+  if (!(std::sqrt(shift2) <= 1e-3 * spacing))
+  {
+    change << "origin moved by " << std::sqrt(shift2) << " mm; ";
+  }
+  std::string text = change.str();
+  return text.empty() ? text : text.substr(0, text.size() - 2);
 }
 
 //----------------------------------------------------------------------------
@@ -382,58 +473,63 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
   anatomy->GetIJKToRASMatrix(ijkToRas);
 
   vtkVolumeCutField* field = cutNode->GetCutField();
-  bool matches = field != nullptr && field->GetSubVoxelFactor() == cutNode->GetSubVoxelFactor();
-  if (matches)
+  const bool hasCut = field && field->GetSubVoxelFactor() > 0;
+  const std::string change = hasCut ? DescribeGridChange(field, anatomyDimensions, ijkToRas, cutNode->GetSubVoxelFactor()) : std::string("new");
+  if (hasCut && change.empty())
   {
-    vtkNew<vtkMatrix4x4> fieldToRas;
-    field->GetSubVoxelIJKToRAS(fieldToRas);
-    const int factor = field->GetSubVoxelFactor();
-    for (int axis = 0; axis < 3 && matches; ++axis)
-    {
-      matches = field->GetDimensions()[axis] == anatomyDimensions[axis] * factor;
-      for (int row = 0; row < 3 && matches; ++row)
-      {
-        matches = std::abs(fieldToRas->GetElement(row, axis) * factor - ijkToRas->GetElement(row, axis)) < 1e-9;
-      }
-    }
-    // Sub-voxel 0 sits (0.5 / f - 0.5) anatomy voxels from anatomy voxel 0.
-    for (int row = 0; row < 3 && matches; ++row)
-    {
-      double expected = ijkToRas->GetElement(row, 3);
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        expected += ijkToRas->GetElement(row, axis) * (0.5 / factor - 0.5);
-      }
-      matches = std::abs(fieldToRas->GetElement(row, 3) - expected) < 1e-9;
-    }
+    this->UpdateProtection(cutNode, field);
+    return field;
   }
-  if (!matches)
+  vtkNew<vtkVolumeCutField> newField;
+  if (!newField->Initialize(anatomyDimensions, ijkToRas, cutNode->GetSubVoxelFactor()))
   {
-    vtkNew<vtkVolumeCutField> newField;
-    if (!newField->Initialize(anatomyDimensions, ijkToRas, cutNode->GetSubVoxelFactor()))
+    return nullptr;
+  }
+  const std::string nodeName = cutNode->GetName() ? cutNode->GetName() : "";
+  if (hasCut && field->GetNumberOfAllocatedBricks() > 0)
+  {
+    // Nothing the user made is dropped: the cut moves onto the new grid,
+    // or the change is refused if the new grid cannot hold all of it.
+    newField->ResampleFrom(field);
+    this->UpdateProtection(cutNode, newField, true);
+    const double before = field->ComputeRemovedVolume();
+    const double after = newField->ComputeRemovedVolume();
+    if (std::abs(after - before) > 0.01 * before + 1e-6)
     {
+      this->ProtectionSources.erase(cutNode->GetID());
+      vtkErrorMacro("GetCutField: the anatomy grid of '" << nodeName << "' changed (" << change << "), and the cut of " << before
+                                                         << " mm^3 would become " << after
+                                                         << " mm^3 on the new grid; the change is refused and the cut is kept. Put back the anatomy"
+                                                            " volume it was made on, or clear the cut to start anew.");
       return nullptr;
     }
-    if (field)
-    {
-      vtkWarningMacro("GetCutField: the anatomy grid or sub-voxel factor of '" << (cutNode->GetName() ? cutNode->GetName() : "")
-                                                                                << "' changed; its cut starts anew");
-    }
-    cutNode->SetCutField(newField);
-    this->ProtectionSources.erase(cutNode->GetID());
-    this->UpdateProtection(cutNode, newField);
-    return newField;
+    vtkWarningMacro("GetCutField: the anatomy grid of '" << nodeName << "' changed (" << change << "); the cut (" << before
+                                                         << " mm^3) was resampled onto the new grid (" << after << " mm^3) and its undo history cleared");
   }
-  this->UpdateProtection(cutNode, field);
-  return field;
+  cutNode->SetCutField(newField);
+  this->ProtectionSources.erase(cutNode->GetID());
+  this->UpdateProtection(cutNode, newField);
+  return newField;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::ClearCut(vtkMRMLVolumeCutNode* cutNode)
+{
+  if (cutNode)
+  {
+    cutNode->SetCutField(nullptr);
+    if (cutNode->GetID())
+    {
+      this->ForgetNode(cutNode->GetID());
+    }
+    NotifyCutModified(cutNode, true);
+  }
 }
 
 //----------------------------------------------------------------------------
 std::vector<std::string> vtkSlicerVolumeCuttingLogic::GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode)
 {
-  // Tool sensibility: a tool affects only cuttable segments. The others are
-  // shielded: first the ones without a role, then the protected ones, so that
-  // where segments overlap a protected one names the voxel.
+  // Tool sensibility: a tool affects only cuttable segments.
   std::vector<std::string> shielded;
   vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
   if (!segmentationNode)
@@ -457,37 +553,84 @@ std::vector<std::string> vtkSlicerVolumeCuttingLogic::GetShieldedSegmentIDs(vtkM
 }
 
 //----------------------------------------------------------------------------
-void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field)
+vtkSlicerVolumeCuttingSegmentLayers* vtkSlicerVolumeCuttingLogic::GetSegmentLayers(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
+  vtkMRMLScalarVolumeNode* anatomy = cutNode ? cutNode->GetAnatomyVolumeNode() : nullptr;
+  if (!segmentationNode || !anatomy || !anatomy->GetImageData() || !cutNode->GetID())
+  {
+    return nullptr;
+  }
+  auto& layers = this->SegmentLayers[cutNode->GetID()];
+  if (!layers)
+  {
+    layers = vtkSmartPointer<vtkSlicerVolumeCuttingSegmentLayers>::New();
+  }
+  int dimensions[3];
+  anatomy->GetImageData()->GetDimensions(dimensions);
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  return layers->Update(segmentationNode->GetSegmentation(), dimensions, ijkToRas) ? layers.GetPointer() : nullptr;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field, bool force)
 {
   vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
-  const std::vector<std::string> protectedIds = GetShieldedSegmentIDs(cutNode);
+  const std::vector<std::string> shieldedIds = GetShieldedSegmentIDs(cutNode);
+  vtkSlicerVolumeCuttingSegmentLayers* layers = this->GetSegmentLayers(cutNode);
   std::ostringstream source;
+  source << field;
   if (segmentationNode)
   {
-    source << segmentationNode->GetID() << "@" << segmentationNode->GetSegmentation()->GetMTime();
+    source << "|" << segmentationNode->GetID() << "@" << segmentationNode->GetSegmentation()->GetMTime();
   }
-  for (const std::string& id : protectedIds)
+  for (const std::string& id : shieldedIds)
   {
     source << "|" << id;
   }
-  source << "#" << protectedIds.size();
+  source << "#" << shieldedIds.size();
   std::string& last = this->ProtectionSources[cutNode->GetID()];
-  if (last == source.str())
+  if (!force && last == source.str())
   {
     return;
   }
   last = source.str();
-  if (!segmentationNode || protectedIds.empty())
+  // Only a table of which layer values are shielded: no volume-sized work.
+  vtkVolumeCutProtection* protection = field->GetProtection();
+  protection->RemoveAllLabelImages();
+  this->ShieldedSegments[cutNode->GetID()] = shieldedIds;
+  if (!layers || shieldedIds.empty())
   {
-    field->SetProtectedLabels(nullptr);
     return;
   }
-  vtkNew<vtkImageData> labels;
-  for (const std::string& id : CreateSegmentLabelMap(cutNode, protectedIds, labels))
+  for (int index = 0; index < layers->GetNumberOfLayers(); ++index)
+  {
+    protection->AddLabelImage(layers->GetLayer(index));
+  }
+  if (shieldedIds.size() > 255)
+  {
+    vtkWarningMacro("UpdateProtection: " << shieldedIds.size() << " segments are kept out of cutting; contacts with those after the 255th are reported as the 255th");
+  }
+  std::vector<std::string> missing;
+  for (size_t index = 0; index < shieldedIds.size(); ++index)
+  {
+    int value = 0;
+    const int layer = layers->GetSegmentLayer(shieldedIds[index], value);
+    if (layer < 0 || value < 1 || !protection->SetShieldLabel(layer, value, static_cast<int>(std::min<size_t>(index + 1, 255))))
+    {
+      missing.push_back(shieldedIds[index]);
+    }
+  }
+  for (const std::string& id : missing)
   {
     vtkWarningMacro("UpdateProtection: segment '" << id << "' has no labelmap on the anatomy grid; tools are not kept out of it");
   }
-  field->SetProtectedLabels(labels);
+  if (!layers->GetResampledSegmentIDs().empty())
+  {
+    vtkWarningMacro("UpdateProtection: " << layers->GetResampledSegmentIDs().size()
+                                         << " segment(s) are not on the anatomy's voxel grid and were resampled onto it; their protection is only as exact as that");
+  }
 }
 
 //----------------------------------------------------------------------------
@@ -596,9 +739,9 @@ bool vtkSlicerVolumeCuttingLogic::CreateSegmentFractionOnAnatomyGrid(
 std::string vtkSlicerVolumeCuttingLogic::GetContactSegmentID(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  const std::vector<std::string> protectedIds = GetShieldedSegmentIDs(cutNode);
   const int label = field ? field->GetContactLabel() : 0;
-  return label > 0 && label <= static_cast<int>(protectedIds.size()) ? protectedIds[label - 1] : std::string();
+  const std::vector<std::string>& shieldedIds = this->ShieldedSegments[cutNode->GetID()];
+  return label > 0 && label <= static_cast<int>(shieldedIds.size()) ? shieldedIds[label - 1] : std::string();
 }
 
 //----------------------------------------------------------------------------
@@ -609,6 +752,9 @@ bool vtkSlicerVolumeCuttingLogic::BeginStroke(vtkMRMLVolumeCutNode* cutNode)
   {
     return false;
   }
+  // Contacts are reported per stroke.
+  field->ResetContact();
+  this->ReportedContactDepths[cutNode->GetID()] = 0.0;
   field->BeginStroke();
   return true;
 }
@@ -624,12 +770,50 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetStrokeField(vtkMRMLVolumeCutN
 }
 
 //----------------------------------------------------------------------------
+template <typename Apply>
+bool vtkSlicerVolumeCuttingLogic::ApplyStroke(vtkMRMLVolumeCutNode* cutNode, Apply&& apply)
+{
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
+  if (!field)
+  {
+    return false;
+  }
+  // A pose outside a stroke is a stroke of its own.
+  const bool ownStroke = !field->IsStrokeOpen();
+  if (ownStroke && !this->BeginStroke(cutNode))
+  {
+    return false;
+  }
+  const bool accepted = apply(field);
+  this->NotifyCutModified(cutNode, accepted);
+  if (ownStroke)
+  {
+    this->EndStroke(cutNode);
+  }
+  return accepted;
+}
+
+//----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::NotifyCutModified(vtkMRMLVolumeCutNode* cutNode, bool changed)
 {
+  if (!cutNode)
+  {
+    return changed;
+  }
   // Views re-render; they find the modified bricks by their stamps.
-  if (changed && cutNode)
+  if (changed)
   {
     cutNode->InvokeCustomModifiedEvent(vtkMRMLVolumeCutNode::CutModifiedEvent);
+  }
+  vtkVolumeCutField* field = cutNode->GetCutField();
+  if (field && cutNode->GetID() && field->GetMaximumContactDepth() > 0.0)
+  {
+    double& reported = this->ReportedContactDepths[cutNode->GetID()];
+    if (field->GetMaximumContactDepth() > reported)
+    {
+      reported = field->GetMaximumContactDepth();
+      cutNode->InvokeCustomModifiedEvent(vtkMRMLVolumeCutNode::ProtectedContactEvent);
+    }
   }
   return changed;
 }
@@ -637,40 +821,38 @@ bool vtkSlicerVolumeCuttingLogic::NotifyCutModified(vtkMRMLVolumeCutNode* cutNod
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
-  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return NotifyCutModified(cutNode, field && field->CutCapsule(p0, p1, radius));
+  return this->ApplyStroke(cutNode, [&](vtkVolumeCutField* field) { return field->CutCapsule(p0, p1, radius); });
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius)
 {
-  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return NotifyCutModified(cutNode, field && field->RestoreCapsule(p0, p1, radius));
+  return this->ApplyStroke(cutNode, [&](vtkVolumeCutField* field) { return field->RestoreCapsule(p0, p1, radius); });
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
-  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return NotifyCutModified(cutNode, field && field->CutToolSweep(tool, pose0, pose1));
+  return this->ApplyStroke(cutNode, [&](vtkVolumeCutField* field) { return field->CutToolSweep(tool, pose0, pose1); });
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
 {
-  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
-  return NotifyCutModified(cutNode, field && field->RestoreToolSweep(tool, pose0, pose1));
+  return this->ApplyStroke(cutNode, [&](vtkVolumeCutField* field) { return field->RestoreToolSweep(tool, pose0, pose1); });
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  vtkVolumeCutField* field = this->GetStrokeField(cutNode);
   if (!field)
   {
     return false;
   }
   field->EndStroke();
+  this->RecordContact(cutNode, field);
+  this->UpdateTablesAfterChange(cutNode);
   return true;
 }
 
@@ -678,14 +860,67 @@ bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
 bool vtkSlicerVolumeCuttingLogic::UndoStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  return NotifyCutModified(cutNode, field && field->Undo());
+  const bool undone = this->NotifyCutModified(cutNode, field && field->Undo());
+  this->UpdateTablesAfterChange(cutNode);
+  return undone;
 }
 
 //----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::RedoStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
-  return NotifyCutModified(cutNode, field && field->Redo());
+  const bool redone = this->NotifyCutModified(cutNode, field && field->Redo());
+  this->UpdateTablesAfterChange(cutNode);
+  return redone;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::UpdateTablesAfterChange(vtkMRMLVolumeCutNode* cutNode)
+{
+  // Only a table the user asked for is kept up to date: its cost follows the cut.
+  if (cutNode && cutNode->GetNodeReference(GetRemovedVolumeTableReferenceRole()))
+  {
+    this->UpdateRemovedVolumeTable(cutNode);
+  }
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingLogic::RecordContact(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field)
+{
+  const double depth = field->GetMaximumContactDepth();
+  if (!(depth > 0.0) || !cutNode->GetID())
+  {
+    return;
+  }
+  vtkMRMLTableNode* table = this->GetContactTableNode(cutNode);
+  if (!table)
+  {
+    return;
+  }
+  const std::string segmentId = this->GetContactSegmentID(cutNode);
+  vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
+  vtkSegment* segment = segmentationNode && !segmentId.empty() ? segmentationNode->GetSegmentation()->GetSegment(segmentId) : nullptr;
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+#ifdef _WIN32
+  gmtime_s(&utc, &now);
+#else
+  gmtime_r(&now, &utc);
+#endif
+  std::ostringstream time;
+  time << std::put_time(&utc, "%Y-%m-%dT%H:%M:%SZ");
+  const double* position = field->GetContactPosition();
+  const int row = table->AddEmptyRow();
+  table->SetCellText(row, 0, segmentId.c_str());
+  table->SetCellText(row, 1, segment && segment->GetName() ? segment->GetName() : "");
+  table->SetCellText(row, 2, time.str().c_str());
+  std::ostringstream value;
+  for (int column = 3; column < 7; ++column)
+  {
+    value.str("");
+    value << (column == 3 ? depth : position[column - 4]);
+    table->SetCellText(row, column, value.str().c_str());
+  }
 }
 
 //----------------------------------------------------------------------------
@@ -693,6 +928,42 @@ double vtkSlicerVolumeCuttingLogic::GetRemovedVolume(vtkMRMLVolumeCutNode* cutNo
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
   return field ? field->ComputeRemovedVolume() : 0.0;
+}
+
+//----------------------------------------------------------------------------
+struct vtkSlicerVolumeCuttingLogic::RemovedVoxelCache
+{
+  vtkMTimeType FieldTime = 0;
+  vtkVolumeCutField* Field = nullptr; // compared only
+  vtkNew<vtkIdTypeArray> VoxelIds;
+  vtkNew<vtkFloatArray> Fractions;
+};
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::GetRemovedVoxels(vtkMRMLVolumeCutNode* cutNode, vtkIdTypeArray* voxelIds, vtkFloatArray* fractions)
+{
+  vtkVolumeCutField* field = this->GetCutField(cutNode);
+  if (!field)
+  {
+    return false;
+  }
+  std::shared_ptr<RemovedVoxelCache>& cache = this->RemovedVoxels[cutNode->GetID()];
+  if (!cache || cache->Field != field || cache->FieldTime != field->GetMTime())
+  {
+    cache = std::make_shared<RemovedVoxelCache>();
+    field->ExportRemovedVoxels(cache->VoxelIds, cache->Fractions);
+    cache->Field = field;
+    cache->FieldTime = field->GetMTime();
+  }
+  if (voxelIds)
+  {
+    voxelIds->DeepCopy(cache->VoxelIds);
+  }
+  if (fractions)
+  {
+    fractions->DeepCopy(cache->Fractions);
+  }
+  return true;
 }
 
 //----------------------------------------------------------------------------
@@ -704,47 +975,127 @@ double vtkSlicerVolumeCuttingLogic::GetRemovedVolumeInSegment(vtkMRMLVolumeCutNo
     vtkErrorMacro("GetRemovedVolumeInSegment: no segment '" << (segmentId ? segmentId : "") << "' in the cut node's segmentation");
     return -1.0;
   }
-  vtkImageData* fraction = this->GetRemovedFraction(cutNode);
-  if (!fraction)
+  if (!this->GetRemovedVoxels(cutNode, nullptr, nullptr))
   {
     return -1.0;
   }
-  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
-  vtkNew<vtkOrientedImageData> anatomyGeometry;
-  GetVolumeGeometry(anatomy, anatomyGeometry);
-  vtkNew<vtkOrientedImageData> segmentMask;
-  if (!segmentationNode->GetBinaryLabelmapRepresentation(segmentId, segmentMask))
+  vtkSlicerVolumeCuttingSegmentLayers* layers = this->GetSegmentLayers(cutNode);
+  int value = 0;
+  const int layer = layers ? layers->GetSegmentLayer(segmentId, value) : -1;
+  if (layer < 0)
   {
     vtkErrorMacro("GetRemovedVolumeInSegment: segment '" << segmentId << "' has no binary labelmap");
     return -1.0;
   }
-  vtkNew<vtkOrientedImageData> mask;
-  if (!vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
-  {
-    vtkErrorMacro("GetRemovedVolumeInSegment: segment '" << segmentId << "' could not be resampled to the anatomy's grid");
-    return -1.0;
-  }
-  int extent[6];
-  mask->GetExtent(extent);
-  const int* dims = fraction->GetDimensions();
-  const float* fractions = static_cast<const float*>(fraction->GetScalarPointer());
+  const RemovedVoxelCache& cache = *this->RemovedVoxels[cutNode->GetID()];
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  const int* dims = anatomy->GetImageData()->GetDimensions();
   double removed = 0.0;
-  for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+  for (vtkIdType n = 0; n < cache.VoxelIds->GetNumberOfValues(); ++n)
   {
-    for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+    const vtkIdType id = cache.VoxelIds->GetValue(n);
+    const int i = static_cast<int>(id % dims[0]);
+    const int j = static_cast<int>((id / dims[0]) % dims[1]);
+    const int k = static_cast<int>(id / (static_cast<vtkIdType>(dims[0]) * dims[1]));
+    if (layers->IsInSegment(layer, value, i, j, k))
     {
-      for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
-      {
-        if (mask->GetScalarComponentAsDouble(i, j, k, 0) > 0.0)
-        {
-          removed += fractions[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i];
-        }
-      }
+      removed += cache.Fractions->GetValue(n);
     }
   }
   vtkNew<vtkMatrix4x4> ijkToRas;
   anatomy->GetIJKToRASMatrix(ijkToRas);
   return removed * std::abs(ijkToRas->Determinant());
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLTableNode* vtkSlicerVolumeCuttingLogic::GetReferencedTable(
+  vtkMRMLVolumeCutNode* cutNode, const char* role, const char* nameSuffix, const std::vector<std::string>& columns)
+{
+  if (!cutNode || !this->GetMRMLScene())
+  {
+    vtkErrorMacro("GetReferencedTable: no volume-cut node in a scene");
+    return nullptr;
+  }
+  vtkMRMLTableNode* table = vtkMRMLTableNode::SafeDownCast(cutNode->GetNodeReference(role));
+  if (table)
+  {
+    return table;
+  }
+  const std::string name = this->GetMRMLScene()->GenerateUniqueName(std::string(cutNode->GetName() ? cutNode->GetName() : "Cut") + " " + nameSuffix);
+  table = vtkMRMLTableNode::SafeDownCast(this->GetMRMLScene()->AddNewNodeByClass("vtkMRMLTableNode", name));
+  if (!table)
+  {
+    return nullptr;
+  }
+  for (const std::string& column : columns)
+  {
+    vtkNew<vtkStringArray> array;
+    array->SetName(column.c_str());
+    table->AddColumn(array);
+  }
+  cutNode->SetNodeReferenceID(role, table->GetID());
+  return table;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLTableNode* vtkSlicerVolumeCuttingLogic::GetRemovedVolumeTableNode(vtkMRMLVolumeCutNode* cutNode)
+{
+  const bool existed = cutNode && cutNode->GetNodeReference(GetRemovedVolumeTableReferenceRole());
+  vtkMRMLTableNode* table =
+    this->GetReferencedTable(cutNode, GetRemovedVolumeTableReferenceRole(), "removed volume", { "Segment", "Name", "Role", "Removed volume" });
+  if (table && !existed)
+  {
+    table->SetColumnUnitLabel("Removed volume", "mm3");
+    table->SetColumnDescription("Removed volume", "Volume removed inside the segment by the cut");
+    this->UpdateRemovedVolumeTable(cutNode);
+  }
+  return table;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLTableNode* vtkSlicerVolumeCuttingLogic::GetContactTableNode(vtkMRMLVolumeCutNode* cutNode)
+{
+  const bool existed = cutNode && cutNode->GetNodeReference(GetContactTableReferenceRole());
+  vtkMRMLTableNode* table = this->GetReferencedTable(cutNode, GetContactTableReferenceRole(), "contacts", { "Segment", "Name", "Time", "Depth", "R", "A", "S" });
+  if (table && !existed)
+  {
+    table->SetColumnUnitLabel("Depth", "mm");
+    table->SetColumnDescription("Depth", "Deepest penetration of the tool into a segment it may not cut, in one stroke");
+    table->SetColumnDescription("Time", "End of the stroke (UTC)");
+  }
+  return table;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLTableNode* vtkSlicerVolumeCuttingLogic::UpdateRemovedVolumeTable(vtkMRMLVolumeCutNode* cutNode)
+{
+  vtkMRMLTableNode* table = vtkMRMLTableNode::SafeDownCast(cutNode ? cutNode->GetNodeReference(GetRemovedVolumeTableReferenceRole()) : nullptr);
+  if (!table)
+  {
+    return this->GetRemovedVolumeTableNode(cutNode);
+  }
+  vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
+  std::vector<std::string> segmentIds;
+  if (segmentationNode)
+  {
+    segmentationNode->GetSegmentation()->GetSegmentIDs(segmentIds);
+  }
+  const int wasModifying = table->StartModify();
+  table->GetTable()->SetNumberOfRows(0);
+  for (const std::string& segmentId : segmentIds)
+  {
+    const double removed = this->GetRemovedVolumeInSegment(cutNode, segmentId.c_str());
+    vtkSegment* segment = segmentationNode->GetSegmentation()->GetSegment(segmentId);
+    const int row = table->AddEmptyRow();
+    table->SetCellText(row, 0, segmentId.c_str());
+    table->SetCellText(row, 1, segment && segment->GetName() ? segment->GetName() : "");
+    table->SetCellText(row, 2, cutNode->IsSegmentCuttable(segmentId) ? "cuttable" : cutNode->IsSegmentProtected(segmentId) ? "protected" : "none");
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(3) << std::max(0.0, removed);
+    table->SetCellText(row, 3, text.str().c_str());
+  }
+  table->EndModify(wasModifying);
+  return table;
 }
 
 //----------------------------------------------------------------------------

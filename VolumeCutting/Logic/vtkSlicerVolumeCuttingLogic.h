@@ -16,6 +16,7 @@
 
 // STD includes
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@
 
 class vtkMRMLMessageCollection;
 class vtkMRMLModelNode;
+class vtkMRMLTableNode;
+class vtkFloatArray;
+class vtkIdTypeArray;
+class vtkSlicerVolumeCuttingSegmentLayers;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
@@ -77,14 +82,28 @@ public:
   /// Returns true when there is no error.
   bool CheckInputs(vtkMRMLVolumeCutNode* cutNode, vtkMRMLMessageCollection* messages);
 
-  /// The cut field of a cut node (held by the node, saved with the scene):
+  /// The cut field of a cut node (held by the node, saved with the scene),
   /// created on first use on the anatomy's voxel grid at the node's sub-voxel
-  /// factor, and created anew (empty) when the
-  /// anatomy's geometry or the factor changes. Its protection follows the
-  /// node's protected segments (labels 1, 2, ... in the order of
-  /// GetProtectedSegmentIDs), updated when they or the segmentation change.
+  /// factor. Grids are compared to a thousandth of a voxel, so a field read
+  /// back from a saved scene is kept bit for bit. When the anatomy's grid or
+  /// the factor really changes, the cut is resampled onto the new grid (a
+  /// warning says what changed; the undo history is cleared); if part of the
+  /// cut would be lost (the new grid does not cover it), the change is refused
+  /// with an error, the old cut stays and nullptr is returned until the grid
+  /// is put back or the cut is cleared (ClearCut).
+  /// Its shield follows the node's segments without a cuttable role (labels
+  /// 1, 2, ... in the order of GetShieldedSegmentIDs), read from the
+  /// segmentation's labelmap layers where tools reach.
   /// nullptr (and an error) when the node has no anatomy with voxels.
   vtkVolumeCutField* GetCutField(vtkMRMLVolumeCutNode* cutNode);
+
+  /// Discard the node's cut (not undoable); the next use starts an empty field.
+  void ClearCut(vtkMRMLVolumeCutNode* cutNode);
+
+  /// Segments kept out of cutting, in label order (label n is element n - 1):
+  /// those without a role first, then the protected ones, so that where
+  /// segments overlap a protected one names the voxel.
+  static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
 
   ///@{
   /// Strokes from any source (mouse, haptic device, replay) go through here.
@@ -116,9 +135,31 @@ public:
 
   /// Volume (mm^3) removed inside a segment: the cut field's removed fraction
   /// of each anatomy voxel, summed over the segment's voxels (resampled to the
-  /// anatomy's grid if needed). Returns -1 and logs an error for an unknown
-  /// segment or a node without segmentation.
+  /// anatomy's grid if needed). A shielded segment reports exactly 0 where
+  /// the field did not remove its voxels' inside. The cost follows the size
+  /// of the cut, not of the volume. Returns -1 and logs an error for an
+  /// unknown segment or a node without segmentation.
   double GetRemovedVolumeInSegment(vtkMRMLVolumeCutNode* cutNode, const char* segmentId);
+
+  /// The anatomy voxels with a removed fraction above zero (linear IJK index)
+  /// and their fractions, computed once per change of the cut. False without a field.
+  bool GetRemovedVoxels(vtkMRMLVolumeCutNode* cutNode, vtkIdTypeArray* voxelIds, vtkFloatArray* fractions);
+
+  ///@{
+  /// Tables the logic keeps up to date as the user drills, referenced by the
+  /// cut node (saved with the scene, shown in Slicer's table views):
+  /// the removed volume per segment (columns Segment, Name, Role, Removed
+  /// volume in mm3), updated at the end of every stroke, undo and redo; and
+  /// the contacts with segments a tool may not cut (Segment, Name, Time,
+  /// Depth in mm, R, A, S), a row per stroke that touched one.
+  /// Created on first request.
+  vtkMRMLTableNode* GetRemovedVolumeTableNode(vtkMRMLVolumeCutNode* cutNode);
+  vtkMRMLTableNode* GetContactTableNode(vtkMRMLVolumeCutNode* cutNode);
+  /// Refill the removed-volume table now; returns it (nullptr without a field).
+  vtkMRMLTableNode* UpdateRemovedVolumeTable(vtkMRMLVolumeCutNode* cutNode);
+  static const char* GetRemovedVolumeTableReferenceRole() { return "removedVolumeTable"; }
+  static const char* GetContactTableReferenceRole() { return "contactTable"; }
+  ///@}
 
   /// Add a segmentation holding the removed region as one segment on the
   /// anatomy's grid: voxels at least half removed (binary labelmap). For
@@ -197,14 +238,45 @@ protected:
 
   /// The field for one pose: checked once per stroke, not per pose.
   vtkVolumeCutField* GetStrokeField(vtkMRMLVolumeCutNode* cutNode);
+  /// Applies one pose (apply(field) returns whether it was accepted), as a
+  /// stroke of its own outside BeginStroke/EndStroke, and notifies views.
+  template <typename Apply>
+  bool ApplyStroke(vtkMRMLVolumeCutNode* cutNode, Apply&& apply);
+  /// Refresh the tables the user has after the cut changed.
+  void UpdateTablesAfterChange(vtkMRMLVolumeCutNode* cutNode);
+  /// Drop or clear what the logic keeps per cut node.
+  void ForgetNode(const std::string& nodeId);
+  void ForgetAllNodes();
 
-  /// Segments kept out of cutting, in label order (label n is element n - 1).
-  static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
-  /// Invokes the node's CutModifiedEvent when \a changed; returns \a changed.
-  static bool NotifyCutModified(vtkMRMLVolumeCutNode* cutNode, bool changed);
+  /// Invokes the node's CutModifiedEvent when \a changed and, when the tool
+  /// went deeper into a shielded segment, its ProtectedContactEvent; returns \a changed.
+  bool NotifyCutModified(vtkMRMLVolumeCutNode* cutNode, bool changed);
 
-  /// Give the field the node's shielded segments as labels on the anatomy grid.
-  void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
+  /// Give the field the node's shielded segments from the segmentation's
+  /// layers (a table change only, when the segmentation did not change).
+  void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field, bool force = false);
+
+  /// What differs between the field's grid and the anatomy's ("" if nothing,
+  /// to a thousandth of a voxel).
+  static std::string DescribeGridChange(vtkVolumeCutField* field, const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int factor);
+
+  /// The segmentation's layers on the anatomy grid, per cut-node ID.
+  vtkSlicerVolumeCuttingSegmentLayers* GetSegmentLayers(vtkMRMLVolumeCutNode* cutNode);
+  std::map<std::string, vtkSmartPointer<vtkSlicerVolumeCuttingSegmentLayers>> SegmentLayers;
+
+  /// The shielded segments each field's labels stand for (label n is element n - 1).
+  std::map<std::string, std::vector<std::string>> ShieldedSegments;
+
+  /// Removed voxels by cut-node ID, with the field modification time they match.
+  struct RemovedVoxelCache;
+  std::map<std::string, std::shared_ptr<RemovedVoxelCache>> RemovedVoxels;
+
+  /// The deepest contact reported in the open stroke, per cut-node ID.
+  std::map<std::string, double> ReportedContactDepths;
+  /// Add a row to the contact table if the stroke that ends touched a shielded segment.
+  void RecordContact(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
+  /// A table referenced by the cut node under a role, created with its columns on first use.
+  vtkMRMLTableNode* GetReferencedTable(vtkMRMLVolumeCutNode* cutNode, const char* role, const char* nameSuffix, const std::vector<std::string>& columns);
 
   /// Rate-based removal state per cut-node ID (its field and anatomy are inputs).
   std::map<std::string, vtkSmartPointer<vtkVolumeCutMaterialRemoval>> MaterialRemovals;

@@ -69,7 +69,11 @@ public:
     SegmentRolesModifiedEvent,
     /// Invoked (by the logic, on the thread that cuts through it) when the
     /// removed region changed: views re-render the modified bricks.
-    CutModifiedEvent
+    CutModifiedEvent,
+    /// Invoked (by the logic) when a tool went deeper into a segment it may
+    /// not cut: the logic's GetContactSegmentID and the field's contact depth
+    /// and position say where. A GUI highlights it at once.
+    ProtectedContactEvent
   };
 
   ///@{

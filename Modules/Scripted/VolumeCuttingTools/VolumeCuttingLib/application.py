@@ -78,13 +78,19 @@ class HeadlessSlicer:
 
     def save_bundle(self, path: str | Path) -> Path:
         """Save the whole scene, with its data, as a Slicer scene bundle (.mrb)."""
-        path = Path(path)
+        # Slicer resolves a bundle's files against the scene's root directory,
+        # not the working directory: a relative path must be made absolute.
+        path = Path(path).expanduser().resolve()
         path.parent.mkdir(parents=True, exist_ok=True)
         if not self.scene.WriteToMRB(str(path)):
             raise RuntimeError(f"Saving the scene to {path} failed (see the log)")
         return path
 
     def load_bundle(self, path: str | Path) -> None:
+        """Replace the scene by a scene bundle (.mrb); a relative path is taken from the working directory."""
+        path = Path(path).expanduser().resolve()
+        if not path.is_file():
+            raise FileNotFoundError(f"No scene bundle at {path}")
         if not self.scene.ReadFromMRB(str(path), True):
             raise RuntimeError(f"Reading the scene bundle {path} failed (see the log)")
 

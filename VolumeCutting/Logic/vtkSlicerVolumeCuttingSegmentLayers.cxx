@@ -1,0 +1,210 @@
+/*==============================================================================
+
+  VolumeCutting: virtual bone drilling and volume cutting for 3D Slicer.
+
+  Licensed under the Apache License, Version 2.0 (the "License");
+  you may not use this file except in compliance with the License.
+  You may obtain a copy of the License at http://www.apache.org/licenses/LICENSE-2.0
+
+==============================================================================*/
+
+#include "vtkSlicerVolumeCuttingSegmentLayers.h"
+
+// SegmentationCore includes
+#include <vtkOrientedImageData.h>
+#include <vtkOrientedImageDataResample.h>
+#include <vtkSegment.h>
+#include <vtkSegmentation.h>
+#include <vtkSegmentationConverter.h>
+
+// VTK includes
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+
+// STD includes
+#include <cmath>
+#include <sstream>
+
+vtkStandardNewMacro(vtkSlicerVolumeCuttingSegmentLayers);
+
+namespace
+{
+/// Grids agree when every voxel corner lies within this fraction of a voxel.
+constexpr double GridTolerance = 1e-3;
+} // namespace
+
+//----------------------------------------------------------------------------
+vtkSlicerVolumeCuttingSegmentLayers::vtkSlicerVolumeCuttingSegmentLayers() = default;
+
+//----------------------------------------------------------------------------
+vtkSlicerVolumeCuttingSegmentLayers::~vtkSlicerVolumeCuttingSegmentLayers() = default;
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingSegmentLayers::GetOffsetOnGrid(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int offset[3])
+{
+  if (!imageToWorld || !anatomyIJKToRAS)
+  {
+    return false;
+  }
+  for (int column = 0; column < 3; ++column)
+  {
+    double length2 = 0.0;
+    double difference2 = 0.0;
+    for (int row = 0; row < 3; ++row)
+    {
+      const double a = anatomyIJKToRAS->GetElement(row, column);
+      const double d = imageToWorld->GetElement(row, column) - a;
+      length2 += a * a;
+      difference2 += d * d;
+    }
+    if (!(difference2 <= GridTolerance * GridTolerance * length2))
+    {
+      return false;
+    }
+  }
+  vtkNew<vtkMatrix4x4> rasToIJK;
+  vtkMatrix4x4::Invert(anatomyIJKToRAS, rasToIJK);
+  const double origin[4] = { imageToWorld->GetElement(0, 3), imageToWorld->GetElement(1, 3), imageToWorld->GetElement(2, 3), 1.0 };
+  double index[4];
+  rasToIJK->MultiplyPoint(origin, index);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double nearest = std::round(index[axis]);
+    if (!(std::abs(index[axis] - nearest) <= GridTolerance))
+    {
+      return false;
+    }
+    offset[axis] = static_cast<int>(nearest);
+  }
+  return true;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingSegmentLayers::Update(vtkSegmentation* segmentation, const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS)
+{
+  if (!segmentation || !anatomyDimensions || !anatomyIJKToRAS)
+  {
+    vtkErrorMacro("Update: a segmentation and an anatomy grid are required");
+    return false;
+  }
+  std::ostringstream gridKey;
+  gridKey.precision(17);
+  gridKey << anatomyDimensions[0] << " " << anatomyDimensions[1] << " " << anatomyDimensions[2];
+  for (int element = 0; element < 12; ++element)
+  {
+    gridKey << " " << anatomyIJKToRAS->GetElement(element / 4, element % 4);
+  }
+  const std::string binary = vtkSegmentationConverter::GetBinaryLabelmapRepresentationName();
+  if (segmentation->GetNumberOfSegments() > 0 && !segmentation->ContainsRepresentation(binary))
+  {
+    segmentation->CreateRepresentation(binary);
+  }
+  if (this->Segmentation == segmentation && this->SegmentationTime == segmentation->GetMTime() && this->GridKey == gridKey.str())
+  {
+    return true;
+  }
+  this->Layers.clear();
+  this->Segments.clear();
+  this->ResampledSegmentIDs.clear();
+  this->Segmentation = segmentation;
+  this->SegmentationTime = segmentation->GetMTime();
+  this->GridKey = gridKey.str();
+
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  anatomyGeometry->SetImageToWorldMatrix(anatomyIJKToRAS);
+  anatomyGeometry->SetExtent(0, anatomyDimensions[0] - 1, 0, anatomyDimensions[1] - 1, 0, anatomyDimensions[2] - 1);
+  const int layerCount = segmentation->GetNumberOfLayers(binary);
+  for (int index = 0; index < layerCount; ++index)
+  {
+    vtkOrientedImageData* layer = vtkOrientedImageData::SafeDownCast(segmentation->GetLayerDataObject(index, binary));
+    if (!layer || !layer->GetPointData()->GetScalars())
+    {
+      continue;
+    }
+    const std::vector<std::string> segmentIds = segmentation->GetSegmentIDsForDataObject(layer, binary);
+    vtkNew<vtkMatrix4x4> layerToWorld;
+    layer->GetImageToWorldMatrix(layerToWorld);
+    int offset[3];
+    auto onGrid = vtkSmartPointer<vtkImageData>::New();
+    if (GetOffsetOnGrid(layerToWorld, anatomyIJKToRAS, offset))
+    {
+      // The layer itself, its extent moved into anatomy IJK: no copy.
+      int extent[6];
+      layer->GetExtent(extent);
+      onGrid->ShallowCopy(layer);
+      onGrid->SetExtent(extent[0] + offset[0], extent[1] + offset[0], extent[2] + offset[1], extent[3] + offset[1], extent[4] + offset[2],
+        extent[5] + offset[2]);
+    }
+    else
+    {
+      vtkNew<vtkOrientedImageData> resampled;
+      if (!vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(layer, anatomyGeometry, resampled, false))
+      {
+        vtkErrorMacro("Update: a labelmap layer of the segmentation could not be resampled onto the anatomy's grid");
+        continue;
+      }
+      onGrid->ShallowCopy(resampled);
+      this->ResampledSegmentIDs.insert(this->ResampledSegmentIDs.end(), segmentIds.begin(), segmentIds.end());
+    }
+    onGrid->SetOrigin(0.0, 0.0, 0.0);
+    onGrid->SetSpacing(1.0, 1.0, 1.0);
+    const int layerIndex = static_cast<int>(this->Layers.size());
+    this->Layers.push_back(onGrid);
+    for (const std::string& segmentId : segmentIds)
+    {
+      vtkSegment* segment = segmentation->GetSegment(segmentId);
+      if (segment)
+      {
+        this->Segments[segmentId] = Placement{ layerIndex, segment->GetLabelValue() };
+      }
+    }
+  }
+  return true;
+}
+
+//----------------------------------------------------------------------------
+vtkImageData* vtkSlicerVolumeCuttingSegmentLayers::GetLayer(int index) const
+{
+  return index >= 0 && index < this->GetNumberOfLayers() ? this->Layers[index].GetPointer() : nullptr;
+}
+
+//----------------------------------------------------------------------------
+int vtkSlicerVolumeCuttingSegmentLayers::GetSegmentLayer(const std::string& segmentId, int& labelValue) const
+{
+  auto found = this->Segments.find(segmentId);
+  if (found == this->Segments.end())
+  {
+    labelValue = 0;
+    return -1;
+  }
+  labelValue = found->second.LabelValue;
+  return found->second.Layer;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingSegmentLayers::IsInSegment(int layer, int labelValue, int i, int j, int k) const
+{
+  vtkImageData* image = this->GetLayer(layer);
+  if (!image)
+  {
+    return false;
+  }
+  const int* extent = image->GetExtent();
+  if (i < extent[0] || i > extent[1] || j < extent[2] || j > extent[3] || k < extent[4] || k > extent[5])
+  {
+    return false;
+  }
+  return static_cast<int>(image->GetScalarComponentAsDouble(i, j, k, 0)) == labelValue;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingSegmentLayers::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Layers: " << this->Layers.size() << "\n";
+  os << indent << "Segments: " << this->Segments.size() << "\n";
+  os << indent << "ResampledSegments: " << this->ResampledSegmentIDs.size() << "\n";
+}
