@@ -503,8 +503,18 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
                                                             " volume it was made on, or clear the cut to start anew.");
       return nullptr;
     }
-    vtkWarningMacro("GetCutField: the anatomy grid of '" << nodeName << "' changed (" << change << "); the cut (" << before
-                                                         << " mm^3) was resampled onto the new grid (" << after << " mm^3) and its undo history cleared");
+    if (!newField->IsSameLattice(field))
+    {
+      vtkWarningMacro("GetCutField: the anatomy grid of '" << nodeName << "' changed (" << change << "); the cut (" << before
+                                                           << " mm^3) was resampled onto the new grid (" << after << " mm^3) and its undo history cleared");
+    }
+    else if (field->GetNumberOfUndoSteps() > 0)
+    {
+      // The same voxels indexed another way (a reader reoriented the scan):
+      // the cut is copied exactly; only its history cannot follow.
+      vtkWarningMacro("GetCutField: the anatomy of '" << nodeName << "' was reindexed (" << change
+                                                      << "); the cut was kept exactly but its undo history was cleared");
+    }
   }
   cutNode->SetCutField(newField);
   this->ProtectionSources.erase(cutNode->GetID());

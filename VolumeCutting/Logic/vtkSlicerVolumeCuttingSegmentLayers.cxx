@@ -43,41 +43,61 @@ vtkSlicerVolumeCuttingSegmentLayers::vtkSlicerVolumeCuttingSegmentLayers() = def
 vtkSlicerVolumeCuttingSegmentLayers::~vtkSlicerVolumeCuttingSegmentLayers() = default;
 
 //----------------------------------------------------------------------------
-bool vtkSlicerVolumeCuttingSegmentLayers::GetOffsetOnGrid(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int offset[3])
+bool vtkSlicerVolumeCuttingSegmentLayers::GetLatticeMap(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int permutation[3][3], int offset[3])
 {
   if (!imageToWorld || !anatomyIJKToRAS)
   {
     return false;
   }
-  for (int column = 0; column < 3; ++column)
+  // Anatomy index of each image index: a = M i + m; one lattice when M is a
+  // signed permutation and m whole numbers (to a thousandth of a voxel).
+  vtkNew<vtkMatrix4x4> rasToIJK;
+  vtkMatrix4x4::Invert(anatomyIJKToRAS, rasToIJK);
+  vtkNew<vtkMatrix4x4> map;
+  vtkMatrix4x4::Multiply4x4(rasToIJK, imageToWorld, map);
+  for (int row = 0; row < 3; ++row)
   {
-    double length2 = 0.0;
-    double difference2 = 0.0;
-    for (int row = 0; row < 3; ++row)
+    int ones = 0;
+    for (int column = 0; column < 4; ++column)
     {
-      const double a = anatomyIJKToRAS->GetElement(row, column);
-      const double d = imageToWorld->GetElement(row, column) - a;
-      length2 += a * a;
-      difference2 += d * d;
+      const double value = map->GetElement(row, column);
+      const double nearest = std::round(value);
+      if (!(std::abs(value - nearest) <= GridTolerance) || (column < 3 && std::abs(nearest) > 1.0))
+      {
+        return false;
+      }
+      if (column < 3)
+      {
+        permutation[row][column] = static_cast<int>(nearest);
+        ones += nearest != 0.0;
+      }
+      else
+      {
+        offset[row] = static_cast<int>(nearest);
+      }
     }
-    if (!(difference2 <= GridTolerance * GridTolerance * length2))
+    if (ones != 1)
     {
       return false;
     }
   }
-  vtkNew<vtkMatrix4x4> rasToIJK;
-  vtkMatrix4x4::Invert(anatomyIJKToRAS, rasToIJK);
-  const double origin[4] = { imageToWorld->GetElement(0, 3), imageToWorld->GetElement(1, 3), imageToWorld->GetElement(2, 3), 1.0 };
-  double index[4];
-  rasToIJK->MultiplyPoint(origin, index);
-  for (int axis = 0; axis < 3; ++axis)
+  return true;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingSegmentLayers::GetOffsetOnGrid(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int offset[3])
+{
+  int permutation[3][3];
+  if (!GetLatticeMap(imageToWorld, anatomyIJKToRAS, permutation, offset))
   {
-    const double nearest = std::round(index[axis]);
-    if (!(std::abs(index[axis] - nearest) <= GridTolerance))
+    return false;
+  }
+  for (int row = 0; row < 3; ++row)
+  {
+    if (permutation[row][row] != 1)
     {
-      return false;
+      return false; // the same voxels in another index order
     }
-    offset[axis] = static_cast<int>(nearest);
   }
   return true;
 }
@@ -147,7 +167,12 @@ bool vtkSlicerVolumeCuttingSegmentLayers::Update(vtkSegmentation* segmentation, 
         continue;
       }
       onGrid->ShallowCopy(resampled);
-      this->ResampledSegmentIDs.insert(this->ResampledSegmentIDs.end(), segmentIds.begin(), segmentIds.end());
+      // A layer on the same voxels in another index order is copied exactly.
+      int permutation[3][3];
+      if (!GetLatticeMap(layerToWorld, anatomyIJKToRAS, permutation, offset))
+      {
+        this->ResampledSegmentIDs.insert(this->ResampledSegmentIDs.end(), segmentIds.begin(), segmentIds.end());
+      }
     }
     onGrid->SetOrigin(0.0, 0.0, 0.0);
     onGrid->SetSpacing(1.0, 1.0, 1.0);

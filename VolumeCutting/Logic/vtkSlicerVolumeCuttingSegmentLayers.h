@@ -60,7 +60,7 @@ public:
   /// segment is unknown or has no labelmap.
   int GetSegmentLayer(const std::string& segmentId, int& labelValue) const;
 
-  /// Segments whose layer was resampled (not on the anatomy grid).
+  /// Segments whose layer was resampled (not on the anatomy's voxels).
   const std::vector<std::string>& GetResampledSegmentIDs() const { return this->ResampledSegmentIDs; }
 
   /// Whether a segment's layer holds its value at anatomy voxel (i, j, k).
@@ -69,6 +69,10 @@ public:
   /// The grid offset (anatomy IJK of the image's voxel 0) of an image with the
   /// given image-to-world matrix, when it lies on the anatomy grid.
   static bool GetOffsetOnGrid(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int offset[3]);
+
+  /// Whether an image lies on the anatomy's voxels in any index order: the
+  /// signed permutation and offset taking its indices to the anatomy's.
+  static bool GetLatticeMap(vtkMatrix4x4* imageToWorld, vtkMatrix4x4* anatomyIJKToRAS, int permutation[3][3], int offset[3]);
 
 protected:
   vtkSlicerVolumeCuttingSegmentLayers();

@@ -1490,12 +1490,127 @@ bool vtkVolumeCutField::ReadFile(const char* fileName)
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutField::GetLatticeMap(vtkVolumeCutField* source, int permutation[3][3], int offset[3]) const
+{
+  if (!source || !source->Directory || !this->Directory || std::abs(source->Quantum - this->Quantum) > 1e-12 * this->Quantum)
+  {
+    return false; // another band: values would need rescaling
+  }
+  // Source index of each target index: s = M t + m. The same lattice indexed
+  // another way (axes flipped or swapped, as volume readers reorient scans)
+  // makes M a signed permutation and m whole numbers, to a thousandth of a
+  // sample over the whole grid.
+  double m[4][4];
+  vtkMatrix4x4::Multiply4x4(&source->RASToSubIJK[0][0], &this->SubIJKToRAS[0][0], &m[0][0]);
+  const double tolerance = 1e-3 / std::max({ this->Dimensions[0], this->Dimensions[1], this->Dimensions[2], 1 });
+  for (int row = 0; row < 3; ++row)
+  {
+    int ones = 0;
+    for (int column = 0; column < 3; ++column)
+    {
+      const double nearest = std::round(m[row][column]);
+      if (!(std::abs(m[row][column] - nearest) <= tolerance) || std::abs(nearest) > 1.0)
+      {
+        return false;
+      }
+      permutation[row][column] = static_cast<int>(nearest);
+      ones += permutation[row][column] != 0;
+    }
+    const double nearest = std::round(m[row][3]);
+    if (ones != 1 || !(std::abs(m[row][3] - nearest) <= 1e-3))
+    {
+      return false;
+    }
+    offset[row] = static_cast<int>(nearest);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::IsSameLattice(vtkVolumeCutField* other)
+{
+  int permutation[3][3];
+  int offset[3];
+  return this->GetLatticeMap(other, permutation, offset);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CopyFromSameLattice(vtkVolumeCutField* source)
+{
+  int permutation[3][3];
+  int offset[3];
+  if (!this->GetLatticeMap(source, permutation, offset))
+  {
+    return false;
+  }
+  BrickStates bricks;
+  const vtkIdType sourceCount = source->GetNumberOfAllocatedBricks();
+  short values[SamplesPerBrick];
+  for (vtkIdType n = 0; n < sourceCount; ++n)
+  {
+    const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
+    source->CopyBrick(brickId, values);
+    const int b[3] = { static_cast<int>(brickId % source->BrickDimensions[0]),
+      static_cast<int>((brickId / source->BrickDimensions[0]) % source->BrickDimensions[1]),
+      static_cast<int>(brickId / (static_cast<vtkIdType>(source->BrickDimensions[0]) * source->BrickDimensions[1])) };
+    for (int local = 0; local < SamplesPerBrick; ++local)
+    {
+      if (values[local] == Outside)
+      {
+        continue;
+      }
+      const int sample[3] = { b[0] * BrickSize + local % BrickSize, b[1] * BrickSize + (local / BrickSize) % BrickSize,
+        b[2] * BrickSize + local / (BrickSize * BrickSize) };
+      if (sample[0] >= source->Dimensions[0] || sample[1] >= source->Dimensions[1] || sample[2] >= source->Dimensions[2])
+      {
+        continue;
+      }
+      // t = M^T (s - m): the inverse of a signed permutation is its transpose.
+      int target[3];
+      bool inside = true;
+      for (int column = 0; column < 3; ++column)
+      {
+        target[column] = 0;
+        for (int row = 0; row < 3; ++row)
+        {
+          target[column] += permutation[row][column] * (sample[row] - offset[row]);
+        }
+        inside &= target[column] >= 0 && target[column] < this->Dimensions[column];
+      }
+      if (!inside)
+      {
+        continue;
+      }
+      const vtkIdType targetBrick =
+        (static_cast<vtkIdType>(target[2] / BrickSize) * this->BrickDimensions[1] + target[1] / BrickSize) * this->BrickDimensions[0] + target[0] / BrickSize;
+      BrickValues& targetValues = bricks[targetBrick];
+      if (targetValues.empty())
+      {
+        targetValues.assign(SamplesPerBrick, Outside);
+      }
+      targetValues[((target[2] % BrickSize) * BrickSize + target[1] % BrickSize) * BrickSize + target[0] % BrickSize] = values[local];
+    }
+  }
+  this->EndStroke();
+  this->UndoStack.clear();
+  this->RedoStack.clear();
+  this->UndoMemorySize = 0;
+  this->LastCapsule.Valid = false;
+  this->WriteBricks(bricks);
+  return true;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
 {
   if (!source || !source->Directory || !this->Directory)
   {
     vtkErrorMacro("ResampleFrom: both fields must be initialized");
     return false;
+  }
+  if (this->CopyFromSameLattice(source))
+  {
+    return true;
   }
   // The target bricks that any allocated source brick can reach: elsewhere
   // the source reads +BandWidth, which is what an unallocated brick holds.

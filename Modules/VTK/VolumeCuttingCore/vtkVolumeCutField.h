@@ -216,9 +216,18 @@ public:
    * takes the other field's signed distance at its position, so the removed
    * region is kept to within the coarser grid's accuracy. The undo history
    * starts empty. Returns false (and an error), changing nothing, if either
-   * field is not initialized.
+   * field is not initialized. Where both grids are the same lattice indexed
+   * another way (axes flipped or swapped, as readers reorient scans), the
+   * samples are copied exactly instead (see IsSameLattice).
    */
   bool ResampleFrom(vtkVolumeCutField* source);
+
+  /**
+   * Whether another initialized field's samples lie exactly where this
+   * field's do (to a thousandth of a sample), whatever the order of their
+   * axes: then ResampleFrom copies them bit for bit.
+   */
+  bool IsSameLattice(vtkVolumeCutField* other);
 
   /// Includes changes of the shield, which change what exports report.
   vtkMTimeType GetMTime() override;
@@ -401,6 +410,10 @@ protected:
   void WriteBricks(const BrickStates& bricks);
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
+  /// ResampleFrom's exact path: false, changing nothing, unless the grids are one lattice.
+  bool CopyFromSameLattice(vtkVolumeCutField* source);
+  /// The signed permutation and offset taking this field's indices to the other's, if one lattice.
+  bool GetLatticeMap(vtkVolumeCutField* source, int permutation[3][3], int offset[3]) const;
   /// The removed fraction of a sample from the field alone (no shield).
   double ComputeRemovedFraction(int i, int j, int k) const;
   /// Calls visit(i, j, k, shielded) for every sample of every allocated
