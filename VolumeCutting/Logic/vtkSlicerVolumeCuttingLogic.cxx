@@ -17,6 +17,7 @@
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutMaterialRemoval.h"
+#include "vtkVolumeCutRemovedVoxels.h"
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
@@ -936,44 +937,105 @@ void vtkSlicerVolumeCuttingLogic::RecordContact(vtkMRMLVolumeCutNode* cutNode, v
 //----------------------------------------------------------------------------
 double vtkSlicerVolumeCuttingLogic::GetRemovedVolume(vtkMRMLVolumeCutNode* cutNode)
 {
-  vtkVolumeCutField* field = this->GetCutField(cutNode);
-  return field ? field->ComputeRemovedVolume() : 0.0;
+  vtkVolumeCutRemovedVoxels* voxels = this->UpdateRemovedVoxels(cutNode);
+  if (!voxels)
+  {
+    return 0.0;
+  }
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  cutNode->GetAnatomyVolumeNode()->GetIJKToRASMatrix(ijkToRas);
+  return voxels->GetTotalFraction() * std::abs(ijkToRas->Determinant());
 }
 
 //----------------------------------------------------------------------------
-struct vtkSlicerVolumeCuttingLogic::RemovedVoxelCache
-{
-  vtkMTimeType FieldTime = 0;
-  vtkVolumeCutField* Field = nullptr; // compared only
-  vtkNew<vtkIdTypeArray> VoxelIds;
-  vtkNew<vtkFloatArray> Fractions;
-};
-
-//----------------------------------------------------------------------------
-bool vtkSlicerVolumeCuttingLogic::GetRemovedVoxels(vtkMRMLVolumeCutNode* cutNode, vtkIdTypeArray* voxelIds, vtkFloatArray* fractions)
+vtkVolumeCutRemovedVoxels* vtkSlicerVolumeCuttingLogic::UpdateRemovedVoxels(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetCutField(cutNode);
   if (!field)
   {
+    return nullptr;
+  }
+  vtkSmartPointer<vtkVolumeCutRemovedVoxels>& voxels = this->RemovedVoxels[cutNode->GetID()];
+  if (!voxels)
+  {
+    voxels = vtkSmartPointer<vtkVolumeCutRemovedVoxels>::New();
+  }
+  voxels->Update(field);
+  return voxels;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::GetRemovedVoxels(vtkMRMLVolumeCutNode* cutNode, vtkIdTypeArray* voxelIds, vtkFloatArray* fractions)
+{
+  vtkVolumeCutRemovedVoxels* voxels = this->UpdateRemovedVoxels(cutNode);
+  if (!voxels)
+  {
     return false;
   }
-  std::shared_ptr<RemovedVoxelCache>& cache = this->RemovedVoxels[cutNode->GetID()];
-  if (!cache || cache->Field != field || cache->FieldTime != field->GetMTime())
-  {
-    cache = std::make_shared<RemovedVoxelCache>();
-    field->ExportRemovedVoxels(cache->VoxelIds, cache->Fractions);
-    cache->Field = field;
-    cache->FieldTime = field->GetMTime();
-  }
-  if (voxelIds)
-  {
-    voxelIds->DeepCopy(cache->VoxelIds);
-  }
-  if (fractions)
-  {
-    fractions->DeepCopy(cache->Fractions);
-  }
+  voxels->GetVoxels(voxelIds, fractions);
   return true;
+}
+
+//----------------------------------------------------------------------------
+std::map<std::string, double> vtkSlicerVolumeCuttingLogic::ComputeRemovedVolumePerSegment(
+  vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds)
+{
+  std::map<std::string, double> volumes;
+  vtkVolumeCutRemovedVoxels* voxels = this->UpdateRemovedVoxels(cutNode);
+  vtkSlicerVolumeCuttingSegmentLayers* layers = voxels ? this->GetSegmentLayers(cutNode) : nullptr;
+  if (!layers)
+  {
+    return volumes;
+  }
+  // Which segment each (layer, value) stands for; one read per layer and voxel.
+  std::vector<std::map<int, std::vector<std::string>>> byValue(static_cast<size_t>(layers->GetNumberOfLayers()));
+  for (const std::string& segmentId : segmentIds)
+  {
+    int value = 0;
+    const int layer = layers->GetSegmentLayer(segmentId, value);
+    if (layer >= 0)
+    {
+      byValue[layer][value].push_back(segmentId);
+      volumes[segmentId] = 0.0;
+    }
+  }
+  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
+  const int* dims = anatomy->GetImageData()->GetDimensions();
+  std::vector<double> sums;
+  voxels->ForEachVoxel([&](vtkIdType id, float fraction) {
+    const int i = static_cast<int>(id % dims[0]);
+    const int j = static_cast<int>((id / dims[0]) % dims[1]);
+    const int k = static_cast<int>(id / (static_cast<vtkIdType>(dims[0]) * dims[1]));
+    for (int layer = 0; layer < layers->GetNumberOfLayers(); ++layer)
+    {
+      if (byValue[layer].empty())
+      {
+        continue;
+      }
+      vtkImageData* image = layers->GetLayer(layer);
+      const int* extent = image->GetExtent();
+      if (i < extent[0] || i > extent[1] || j < extent[2] || j > extent[3] || k < extent[4] || k > extent[5])
+      {
+        continue;
+      }
+      auto found = byValue[layer].find(static_cast<int>(image->GetScalarComponentAsDouble(i, j, k, 0)));
+      if (found != byValue[layer].end())
+      {
+        for (const std::string& segmentId : found->second)
+        {
+          volumes[segmentId] += fraction;
+        }
+      }
+    }
+  });
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  const double voxelVolume = std::abs(ijkToRas->Determinant());
+  for (auto& entry : volumes)
+  {
+    entry.second *= voxelVolume;
+  }
+  return volumes;
 }
 
 //----------------------------------------------------------------------------
@@ -985,36 +1047,18 @@ double vtkSlicerVolumeCuttingLogic::GetRemovedVolumeInSegment(vtkMRMLVolumeCutNo
     vtkErrorMacro("GetRemovedVolumeInSegment: no segment '" << (segmentId ? segmentId : "") << "' in the cut node's segmentation");
     return -1.0;
   }
-  if (!this->GetRemovedVoxels(cutNode, nullptr, nullptr))
+  if (!this->GetCutField(cutNode))
   {
     return -1.0;
   }
-  vtkSlicerVolumeCuttingSegmentLayers* layers = this->GetSegmentLayers(cutNode);
-  int value = 0;
-  const int layer = layers ? layers->GetSegmentLayer(segmentId, value) : -1;
-  if (layer < 0)
+  const std::map<std::string, double> volumes = this->ComputeRemovedVolumePerSegment(cutNode, { segmentId });
+  auto found = volumes.find(segmentId);
+  if (found == volumes.end())
   {
     vtkErrorMacro("GetRemovedVolumeInSegment: segment '" << segmentId << "' has no binary labelmap");
     return -1.0;
   }
-  const RemovedVoxelCache& cache = *this->RemovedVoxels[cutNode->GetID()];
-  vtkMRMLScalarVolumeNode* anatomy = cutNode->GetAnatomyVolumeNode();
-  const int* dims = anatomy->GetImageData()->GetDimensions();
-  double removed = 0.0;
-  for (vtkIdType n = 0; n < cache.VoxelIds->GetNumberOfValues(); ++n)
-  {
-    const vtkIdType id = cache.VoxelIds->GetValue(n);
-    const int i = static_cast<int>(id % dims[0]);
-    const int j = static_cast<int>((id / dims[0]) % dims[1]);
-    const int k = static_cast<int>(id / (static_cast<vtkIdType>(dims[0]) * dims[1]));
-    if (layers->IsInSegment(layer, value, i, j, k))
-    {
-      removed += cache.Fractions->GetValue(n);
-    }
-  }
-  vtkNew<vtkMatrix4x4> ijkToRas;
-  anatomy->GetIJKToRASMatrix(ijkToRas);
-  return removed * std::abs(ijkToRas->Determinant());
+  return found->second;
 }
 
 //----------------------------------------------------------------------------
@@ -1090,11 +1134,13 @@ vtkMRMLTableNode* vtkSlicerVolumeCuttingLogic::UpdateRemovedVolumeTable(vtkMRMLV
   {
     segmentationNode->GetSegmentation()->GetSegmentIDs(segmentIds);
   }
+  const std::map<std::string, double> volumes = this->ComputeRemovedVolumePerSegment(cutNode, segmentIds);
   const int wasModifying = table->StartModify();
   table->GetTable()->SetNumberOfRows(0);
   for (const std::string& segmentId : segmentIds)
   {
-    const double removed = this->GetRemovedVolumeInSegment(cutNode, segmentId.c_str());
+    auto found = volumes.find(segmentId);
+    const double removed = found != volumes.end() ? found->second : 0.0;
     vtkSegment* segment = segmentationNode->GetSegmentation()->GetSegment(segmentId);
     const int row = table->AddEmptyRow();
     table->SetCellText(row, 0, segmentId.c_str());
@@ -1243,12 +1289,21 @@ vtkImageData* vtkSlicerVolumeCuttingLogic::GetRemovedFraction(vtkMRMLVolumeCutNo
   {
     return nullptr;
   }
+  vtkVolumeCutRemovedVoxels* voxels = this->UpdateRemovedVoxels(cutNode);
   auto& cached = this->RemovedFractions[cutNode->GetID()];
-  if (!cached.second || cached.first != field->GetMTime())
+  if (!cached.second || cached.first != voxels->GetMTime())
   {
+    // Dense, from the tally of removed voxels: only the cut's voxels are written.
+    const int* dims = cutNode->GetAnatomyVolumeNode()->GetImageData()->GetDimensions();
     cached.second = vtkSmartPointer<vtkImageData>::New();
-    field->ExportRemovedFraction(cached.second);
-    cached.first = field->GetMTime();
+    cached.second->SetDimensions(dims[0], dims[1], dims[2]);
+    cached.second->AllocateScalars(VTK_FLOAT, 1);
+    vtkFloatArray* scalars = vtkFloatArray::SafeDownCast(cached.second->GetPointData()->GetScalars());
+    scalars->SetName("RemovedFraction");
+    scalars->FillValue(0.0f);
+    float* values = scalars->GetPointer(0);
+    voxels->ForEachVoxel([values](vtkIdType id, float fraction) { values[id] = fraction; });
+    cached.first = voxels->GetMTime();
   }
   return cached.second;
 }

@@ -39,6 +39,7 @@ class vtkImageData;
 class vtkMatrix4x4;
 class vtkVolumeCutField;
 class vtkVolumeCutMaterialRemoval;
+class vtkVolumeCutRemovedVoxels;
 class vtkVolumeCutTool;
 
 /// \brief Builds and checks volume-cutting sessions.
@@ -267,9 +268,12 @@ protected:
   /// The shielded segments each field's labels stand for (label n is element n - 1).
   std::map<std::string, std::vector<std::string>> ShieldedSegments;
 
-  /// Removed voxels by cut-node ID, with the field modification time they match.
-  struct RemovedVoxelCache;
-  std::map<std::string, std::shared_ptr<RemovedVoxelCache>> RemovedVoxels;
+  /// Removed voxels by cut-node ID, updated brick by brick as the cut changes.
+  std::map<std::string, vtkSmartPointer<vtkVolumeCutRemovedVoxels>> RemovedVoxels;
+  /// The up-to-date removed voxels of a node's field (nullptr without one).
+  vtkVolumeCutRemovedVoxels* UpdateRemovedVoxels(vtkMRMLVolumeCutNode* cutNode);
+  /// Removed volume (mm^3) of every segment of the node's segmentation, in one pass over the removed voxels.
+  std::map<std::string, double> ComputeRemovedVolumePerSegment(vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds);
 
   /// The deepest contact reported in the open stroke, per cut-node ID.
   std::map<std::string, double> ReportedContactDepths;

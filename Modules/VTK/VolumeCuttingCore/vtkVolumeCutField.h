@@ -301,6 +301,14 @@ public:
   void ExportRemovedVoxels(vtkIdTypeArray* anatomyVoxelIds, vtkFloatArray* fractions) const;
 
   /**
+   * Append the removed voxels of one brick (the anatomy voxels it holds: a
+   * brick spans whole anatomy voxels) to the arrays, as ExportRemovedVoxels
+   * does. A brick's fractions read the samples of its 26 neighbours too: for
+   * incremental tallies (vtkVolumeCutRemovedVoxels).
+   */
+  void AppendRemovedVoxelsOfBrick(vtkIdType brickId, vtkIdTypeArray* anatomyVoxelIds, vtkFloatArray* fractions) const;
+
+  /**
    * The boundary of the removed region as a closed triangle surface in RAS
    * (mm), contoured at sub-voxel resolution from the distance samples (flying
    * edges at distance 0). Empty if nothing is removed. For STL export and for
@@ -316,6 +324,8 @@ public:
    */
   vtkTypeUInt64 GetCurrentStamp() const { return this->StampCounter.load(std::memory_order_acquire); }
   void GetBricksModifiedSince(vtkTypeUInt64 stamp, vtkIdList* brickIds) const;
+  /// The stamp of one brick (0 if never written).
+  vtkTypeUInt64 GetBrickStamp(vtkIdType brickId) const;
   vtkGetVector3Macro(BrickDimensions, int);
   ///@}
 
@@ -410,16 +420,19 @@ protected:
   void WriteBricks(const BrickStates& bricks);
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
+  /// The interpolation of InterpolateAtIndex over samples given by read(i, j, k).
+  template <typename SampleReader>
+  double Interpolate(const double index[3], SampleReader&& read) const;
   /// ResampleFrom's exact path: false, changing nothing, unless the grids are one lattice.
   bool CopyFromSameLattice(vtkVolumeCutField* source);
   /// The signed permutation and offset taking this field's indices to the other's, if one lattice.
   bool GetLatticeMap(vtkVolumeCutField* source, int permutation[3][3], int offset[3]) const;
   /// The removed fraction of a sample from the field alone (no shield).
   double ComputeRemovedFraction(int i, int j, int k) const;
-  /// Calls visit(i, j, k, shielded) for every sample of every allocated
-  /// brick; shielded: the sample's anatomy voxel is in a shielded structure.
+  /// Calls visit(i, j, k, shielded) for every sample of a brick; shielded:
+  /// the sample's anatomy voxel is in a shielded structure.
   template <typename Visitor>
-  void ForEachAllocatedSampleWithShield(Visitor&& visit) const;
+  void ForEachSampleOfBrickWithShield(vtkIdType brickId, Visitor&& visit) const;
   void Reset();
   /// The shield of a brick (built on first reach), nullptr where the tool cuts freely.
   const vtkVolumeCutProtection::Brick* GetProtectionBrick(vtkIdType brickId);
