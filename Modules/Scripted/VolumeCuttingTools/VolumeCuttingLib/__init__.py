@@ -6,6 +6,10 @@ Modules:
     nodes: numpy <-> MRML volume helpers shared by the two.
     application: a scene with Slicer's logics and an offscreen 3D view, without Qt.
     drilling: scripted drilling paths (cortical mastoidectomy) replayed through the logic.
+    owndata: the user's own CT (DICOM series, NRRD, NIfTI, MetaImage) and segmentation (.seg.nrrd or
+        labelmap with a colour table) through Slicer's storage nodes; roles by segment name; InputError.
+    dicomseries: write a scalar volume as a DICOM CT series (pydicom), any IJK-to-RAS.
+    patientscale: the patient-scale test case (512 x 512 x 133 CT from the head CT, long segments), cached.
     mainjob: the README's main job.
     benchmarks: the benchmark harness (one JSON per area).
     analyticscene: the mapper's accuracy scene (a cut cube) and its exact ray tracing and metrics.

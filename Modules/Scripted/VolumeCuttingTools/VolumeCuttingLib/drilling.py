@@ -70,6 +70,54 @@ def lateral_entry(volume_node, y: float, z: float, threshold: float = 700.0) -> 
     raise ValueError(f"no bone above {threshold} HU along x at y={y:.1f}, z={z:.1f} mm")
 
 
+def lateral_entry_into_segments(segmentation_node, segment_ids, direction=(-1.0, 0.0, 0.0)) -> np.ndarray:
+    """Where a tool moving along ``direction`` (default: from the patient's right) first meets the segments.
+
+    The approach line runs through the centre of the segments' bounds, or,
+    if that line misses them, the nearest parallel line that meets them; the
+    entry is the centre of the first segment voxel along it (RAS mm). This is
+    ``lateral_entry`` for any segmentation, on any voxel grid.
+    """
+    import slicer
+    import vtk
+
+    direction = np.asarray(direction, dtype=float)
+    direction /= np.linalg.norm(direction)
+    segmentation = segmentation_node.GetSegmentation()
+    points, voxel_sizes = [], []
+    for segment_id in segment_ids:
+        segment = segmentation.GetSegment(segment_id)
+        labelmap = slicer.vtkOrientedImageData()
+        if segment is None or not slicer.vtkSlicerSegmentationsModuleLogic.GetSegmentBinaryLabelmapRepresentation(
+                segmentation_node, segment_id, labelmap):
+            raise ValueError(f"segment {segment_id!r} of {segmentation_node.GetName()!r} has no binary labelmap")
+        extent = labelmap.GetExtent()
+        if extent[1] < extent[0] or extent[3] < extent[2] or extent[5] < extent[4]:
+            continue
+        dims = labelmap.GetDimensions()
+        voxels = numpy_support.vtk_to_numpy(labelmap.GetPointData().GetScalars()).reshape(dims[2], dims[1], dims[0])
+        # Segments may share one labelmap, each with its own label value.
+        kji = np.argwhere(voxels == segment.GetLabelValue())
+        if len(kji) == 0:
+            continue
+        image_to_world = vtk.vtkMatrix4x4()
+        labelmap.GetImageToWorldMatrix(image_to_world)
+        matrix = np.array([[image_to_world.GetElement(r, c) for c in range(4)] for r in range(4)])
+        ijk = kji[:, ::-1] + np.array(extent[0::2])
+        points.append(ijk @ matrix[:3, :3].T + matrix[:3, 3])
+        voxel_sizes.append(float(np.linalg.norm(matrix[:3, :3], axis=0).max()))
+    if not points:
+        raise ValueError(f"the segments {list(segment_ids)} of {segmentation_node.GetName()!r} are empty: nothing to drill")
+    points = np.concatenate(points)
+    center = (points.min(axis=0) + points.max(axis=0)) / 2.0
+    offsets = points - center
+    along = offsets @ direction
+    across = np.linalg.norm(offsets - along[:, None] * direction, axis=1)
+    near_line = across <= across.min() + max(voxel_sizes)
+    first = np.argmin(np.where(near_line, along, np.inf))
+    return points[first]
+
+
 def drill(logic, cut_node, plan: MastoidectomyPlan) -> dict:
     """Replay the plan through the logic; return counts and per-pose timings."""
     pose_times = []

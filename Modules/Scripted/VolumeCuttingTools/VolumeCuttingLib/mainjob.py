@@ -1,9 +1,13 @@
 """The main job: a segmentation-then-drill session without the Slicer GUI.
 
     python -m VolumeCuttingLib.mainjob [--phantom] [--out DIR]
+    python -m VolumeCuttingLib.mainjob --ct PATH [--segmentation PATH] [--color-table PATH]
+                                       [--cuttable NAMES] [--protected NAMES] [--out DIR]
 
-On the real head CT (Debian's invesalius-examples, fetched at setup) or on the
-procedural temporal-bone phantom, it builds what a user builds in Slicer before
+On the real head CT (Debian's invesalius-examples, fetched at setup), on the
+procedural temporal-bone phantom, or on the user's own CT (a DICOM series,
+NRRD, NIfTI or MetaImage) with their own segmentation and segment names
+(``owndata``), it builds what a user builds in Slicer before
 drilling: the CT as a scalar volume, a bone segmentation (region growing into
 cortical and trabecular bone), and a volume-cut node that says which segments a
 tool may cut and which are protected. It renders the 3D view offscreen through
@@ -19,12 +23,13 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import slicer
 
-from . import drilling, headct, phantom
+from . import drilling, headct, owndata, phantom
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -39,6 +44,21 @@ PHANTOM_PROTECTED_SEGMENTS = (
 # the pinned data: slice k=21, row j=108, where the air cells lie behind the
 # ear canal (the lateral cortex there is at i=67).
 HEAD_CT_RIGHT_MASTOID_YZ = (-18.6, -48.75)
+
+# On the user's own CT: a short path into the cuttable bone with a 3.5 mm burr.
+OWN_DATA_PLAN = {"surface_radius": 4.0, "depth": 4.0, "burr_radius": 1.75}
+
+
+@dataclass
+class OwnData:
+    """The user's own input, as given on the command line (names as the user wrote them)."""
+
+    ct: Path
+    segmentation: Path | None = None
+    color_table: Path | None = None
+    cuttable: list = field(default_factory=list)
+    protected: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
 
 
 class Stopwatch:
@@ -58,8 +78,19 @@ class Stopwatch:
         return _Timer()
 
 
-def load_anatomy(application: HeadlessSlicer, use_phantom: bool, seed: int):
+def load_anatomy(application: HeadlessSlicer, use_phantom: bool, seed: int, own_data: OwnData | None = None):
     """Return (ct_volume_node, anatomy_segmentation_node or None, description)."""
+    if own_data is not None:
+        volume = owndata.load_ct(application.scene, own_data.ct, messages=own_data.warnings)
+        segmentation = None
+        if own_data.segmentation is not None:
+            segmentation = owndata.load_segmentation(application.scene, own_data.segmentation, volume,
+                                                     color_table=own_data.color_table, messages=own_data.warnings)
+            own_roles(own_data, segmentation)  # wrong names fail here, before the bone segmentation's time
+        dims = volume.GetImageData().GetDimensions()
+        spacing = volume.GetSpacing()
+        return volume, segmentation, f"user CT {own_data.ct} {dims[0]}x{dims[1]}x{dims[2]} at " + \
+            "x".join(f"{s:.3f}" for s in spacing) + " mm"
     if use_phantom:
         generated = phantom.generate_phantom(dimensions=(128, 128, 96), spacing=(0.4, 0.4, 0.5), seed=seed)
         volume, segmentation = phantom.create_phantom_nodes(application.scene, generated)
@@ -71,9 +102,25 @@ def load_anatomy(application: HeadlessSlicer, use_phantom: bool, seed: int):
         "x".join(f"{s:.3f}" for s in spacing) + " mm"
 
 
-def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool):
+def own_roles(own_data: OwnData, segmentation_node, default_cuttable=()):
+    """The user's roles by name: (cuttable IDs, protected IDs); raises ``owndata.InputError``."""
+    if own_data.segmentation is not None and not own_data.cuttable:
+        segmentation = segmentation_node.GetSegmentation()
+        names = ", ".join(f"'{segmentation.GetSegment(s).GetName()}'" for s in segmentation.GetSegmentIDs())
+        raise owndata.InputError(own_data.segmentation, "no segment is named cuttable",
+                                 f"Say which segments the drill may cut with --cuttable NAMES (its segments: {names}).")
+    return owndata.resolve_roles(segmentation_node, own_data.cuttable or list(default_cuttable), own_data.protected)
+
+
+def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool, own_data: OwnData | None = None):
     segment_ids = set(segmentation_node.GetSegmentation().GetSegmentIDs())
-    if use_phantom:
+    if own_data is not None:
+        # Without a segmentation of the user's, names refer to the automatic bone segments.
+        if own_data.segmentation is None:
+            segmentation_node.SetAttribute(owndata.SOURCE_PATH_ATTRIBUTE, f"{own_data.ct} (automatic bone segmentation)")
+        cuttable, protected = own_roles(
+            own_data, segmentation_node, [logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()])
+    elif use_phantom:
         cuttable = [s for s in PHANTOM_CUTTABLE_SEGMENTS if s in segment_ids]
         protected = [s for s in PHANTOM_PROTECTED_SEGMENTS if s in segment_ids]
     else:
@@ -92,21 +139,22 @@ def lateral_camera(view, segmentation_node, segment_ids):
     view.look_at(center, direction=(1.0, 0.0, 0.0), distance=2.2 * extent, view_up=(0.0, 0.0, 1.0))
 
 
-def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> dict:
-    out_dir.mkdir(parents=True, exist_ok=True)
+def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_data: OwnData | None = None) -> dict:
+    """Run the job; ``own_data`` (the user's CT and segmentation) takes the place of the shipped data."""
     timer = Stopwatch()
     application = HeadlessSlicer()
     logic = application.volume_cutting_logic
 
     with timer.measure("load_ct_s"):
-        volume, anatomy_segmentation, description = load_anatomy(application, use_phantom, seed)
+        volume, anatomy_segmentation, description = load_anatomy(application, use_phantom, seed, own_data)
+    out_dir.mkdir(parents=True, exist_ok=True)
     with timer.measure("bone_segmentation_s"):
         bone = logic.CreateBoneSegmentation(volume, 700.0, 200.0, 0.5)
     if bone is None:
         raise RuntimeError("bone segmentation failed (see the log)")
     roles_segmentation = anatomy_segmentation if anatomy_segmentation is not None else bone
     cut_node = logic.AddVolumeCutNode(volume, roles_segmentation)
-    assign_roles(cut_node, roles_segmentation, logic, use_phantom)
+    assign_roles(cut_node, roles_segmentation, logic, use_phantom, own_data)
     messages = slicer.vtkMRMLMessageCollection()
     inputs_ok = logic.CheckInputs(cut_node, messages)
 
@@ -118,6 +166,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         target_yz = ((bounds[2] + bounds[3]) / 2.0, (bounds[4] + bounds[5]) / 2.0)
         plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *target_yz),
                                           surface_radius=7.0, depth=8.0, burr_radius=2.0)
+    elif own_data is not None:
+        # From the patient's right into the cuttable segments, through the centre of their bounds.
+        entry = drilling.lateral_entry_into_segments(roles_segmentation, list(cut_node.GetCuttableSegmentIDs()))
+        plan = drilling.MastoidectomyPlan(entry=entry, **OWN_DATA_PLAN)
     else:
         plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *HEAD_CT_RIGHT_MASTOID_YZ))
     # The cut anatomy as the product shows it: through the adaptive multivolume
@@ -127,9 +179,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
     display.SetVisibility3D(False)
     if anatomy_segmentation is not None:
         # Bone and the structures at risk; soft tissue and air stay hidden.
+        shown = set(PHANTOM_PROTECTED_SEGMENTS + PHANTOM_BONE_SEGMENTS) if own_data is None else \
+            set(cut_node.GetCuttableSegmentIDs()) | set(cut_node.GetProtectedSegmentIDs())
         for segment_id in anatomy_segmentation.GetSegmentation().GetSegmentIDs():
-            display.SetSegmentVisibility3D(segment_id, segment_id in PHANTOM_PROTECTED_SEGMENTS
-                                           or segment_id in PHANTOM_BONE_SEGMENTS)
+            display.SetSegmentVisibility3D(segment_id, segment_id in shown)
     # Bone surface at 300 HU; bone thinner than 1 mm over what lies behind it
     # shows red and translucent (Morris et al.), as a surgeon drilling sees it.
     cut_node.SetSurfaceIsoValue(300.0)
@@ -234,9 +287,28 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768)) -> di
         "scene_bundle": str(bundle),
         "timings": timer.seconds,
     }
+    if own_data is not None:
+        segmentation_of_roles = roles_segmentation.GetSegmentation()
+        summary["own_data"] = {
+            "ct": str(own_data.ct),
+            "segmentation": str(own_data.segmentation) if own_data.segmentation is not None else None,
+            "segment_names": {segment_id: segmentation_of_roles.GetSegment(segment_id).GetName()
+                              for segment_id in segmentation_of_roles.GetSegmentIDs()},
+            "warnings": list(own_data.warnings),
+        }
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     view.close()
     return summary
+
+
+def _image_size(text: str):
+    try:
+        width, height = (int(value) for value in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels, got {text!r}") from None
+    if width < 16 or height < 16:
+        raise argparse.ArgumentTypeError(f"images of at least 16x16 pixels, got {text!r}")
+    return width, height
 
 
 def main(argv=None) -> int:
@@ -244,14 +316,39 @@ def main(argv=None) -> int:
     parser.add_argument("--phantom", action="store_true", help="use the procedural temporal-bone phantom instead of the real head CT")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: out/headct or out/phantom)")
     parser.add_argument("--seed", type=int, default=0, help="noise seed of the phantom")
+    parser.add_argument("--size", type=_image_size, default=(1024, 768), metavar="WxH",
+                        help="size of the rendered images in pixels (default 1024x768)")
+    own = parser.add_argument_group("own data", "drill the user's own CT instead of the shipped data")
+    own.add_argument("--ct", type=Path, default=None,
+                     help="the CT: a DICOM series folder (or one file of it), .nrrd, .nhdr, .nii, .nii.gz, .mha or .mhd")
+    own.add_argument("--segmentation", type=Path, default=None,
+                     help="its segmentation: a Slicer .seg.nrrd or a labelmap volume (default: automatic bone segmentation)")
+    own.add_argument("--color-table", type=Path, default=None,
+                     help="names of the labelmap's labels ('label name R G B A' a line; default: a .ctbl or .txt "
+                          "beside the labelmap with its base name)")
+    own.add_argument("--cuttable", default="", help="comma-separated names of the segments the drill may cut")
+    own.add_argument("--protected", default="", help="comma-separated names of the segments the drill must not cut")
     args = parser.parse_args(argv)
-    out_dir = args.out or Path("out") / ("phantom" if args.phantom else "headct")
+    own_data = None
+    if args.ct is not None:
+        if args.phantom:
+            parser.error("--phantom and --ct exclude each other")
+        own_data = OwnData(ct=args.ct, segmentation=args.segmentation, color_table=args.color_table,
+                           cuttable=owndata.split_names(args.cuttable), protected=owndata.split_names(args.protected))
+    elif args.segmentation or args.color_table or args.cuttable or args.protected:
+        parser.error("--segmentation, --color-table, --cuttable and --protected go with --ct")
+    out_dir = args.out or Path("out") / ("phantom" if args.phantom else "owndata" if own_data else "headct")
     try:
-        summary = run(args.phantom, out_dir, seed=args.seed)
+        summary = run(args.phantom, out_dir, seed=args.seed, size=args.size, own_data=own_data)
+    except owndata.InputError as error:
+        print(f"main job: {error}", file=sys.stderr)
+        return 1
     except (RuntimeError, ValueError, OSError) as error:
         print(f"main job failed: {error}", file=sys.stderr)
         return 1
     print(json.dumps(summary, indent=2))
+    for warning in summary.get("own_data", {}).get("warnings", []):
+        print(f"warning: {warning}", file=sys.stderr)
     return 0 if summary["inputs_ok"] else 1
 
 
