@@ -15,7 +15,6 @@ PySpaceMouse).
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import logging
 from dataclasses import dataclass
 
