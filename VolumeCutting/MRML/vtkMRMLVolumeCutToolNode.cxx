@@ -311,22 +311,25 @@ void vtkMRMLVolumeCutToolNode::SetBurrType(int burrType)
 }
 
 //----------------------------------------------------------------------------
-bool vtkMRMLVolumeCutToolNode::SetValidatedValue(double& member, double value, double minimum, double maximum, const char* property)
+void vtkMRMLVolumeCutToolNode::SetValidatedValue(double& member, double value, double minimum, double maximum, const char* property, bool geometry)
 {
   if (!std::isfinite(value) || value < minimum || value > maximum)
   {
     vtkErrorMacro("Set" << property << ": " << value << " is outside the valid range [" << minimum << ", " << maximum << "] of tool '"
                         << (this->GetName() ? this->GetName() : "") << "' (" << GetShapeAsString(this->Shape) << "); " << property
                         << " stays " << member);
-    return false;
+    return;
   }
   if (value == member)
   {
-    return false;
+    return;
   }
   member = value;
   this->Modified();
-  return true;
+  if (geometry)
+  {
+    this->InvokeCustomModifiedEvent(ToolGeometryModifiedEvent);
+  }
 }
 
 //----------------------------------------------------------------------------
@@ -344,10 +347,7 @@ double vtkMRMLVolumeCutToolNode::GetMaximumDiameter(int shape)
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetDiameter(double diameter)
 {
-  if (this->SetValidatedValue(this->Diameter, diameter, GetMinimumDiameter(this->Shape), GetMaximumDiameter(this->Shape), "Diameter"))
-  {
-    this->InvokeCustomModifiedEvent(ToolGeometryModifiedEvent);
-  }
+  this->SetValidatedValue(this->Diameter, diameter, GetMinimumDiameter(this->Shape), GetMaximumDiameter(this->Shape), "Diameter", true);
 }
 
 //----------------------------------------------------------------------------
@@ -365,10 +365,7 @@ double vtkMRMLVolumeCutToolNode::GetMaximumLength()
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetLength(double length)
 {
-  if (this->SetValidatedValue(this->Length, length, LengthRange[0], LengthRange[1], "Length"))
-  {
-    this->InvokeCustomModifiedEvent(ToolGeometryModifiedEvent);
-  }
+  this->SetValidatedValue(this->Length, length, LengthRange[0], LengthRange[1], "Length", true);
 }
 
 //----------------------------------------------------------------------------
@@ -386,10 +383,7 @@ double vtkMRMLVolumeCutToolNode::GetMaximumThickness()
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetThickness(double thickness)
 {
-  if (this->SetValidatedValue(this->Thickness, thickness, ThicknessRange[0], ThicknessRange[1], "Thickness"))
-  {
-    this->InvokeCustomModifiedEvent(ToolGeometryModifiedEvent);
-  }
+  this->SetValidatedValue(this->Thickness, thickness, ThicknessRange[0], ThicknessRange[1], "Thickness", true);
 }
 
 //----------------------------------------------------------------------------
@@ -407,16 +401,13 @@ double vtkMRMLVolumeCutToolNode::GetMaximumWidth()
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetWidth(double width)
 {
-  if (this->SetValidatedValue(this->Width, width, WidthRange[0], WidthRange[1], "Width"))
-  {
-    this->InvokeCustomModifiedEvent(ToolGeometryModifiedEvent);
-  }
+  this->SetValidatedValue(this->Width, width, WidthRange[0], WidthRange[1], "Width", true);
 }
 
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetPower(double power)
 {
-  this->SetValidatedValue(this->Power, power, 0.0, 1.0, "Power");
+  this->SetValidatedValue(this->Power, power, 0.0, 1.0, "Power", false);
 }
 
 //----------------------------------------------------------------------------
@@ -428,7 +419,7 @@ double vtkMRMLVolumeCutToolNode::GetMaximumSpeed()
 //----------------------------------------------------------------------------
 void vtkMRMLVolumeCutToolNode::SetSpeed(double speed)
 {
-  this->SetValidatedValue(this->Speed, speed, 0.0, MaximumSpeed, "Speed");
+  this->SetValidatedValue(this->Speed, speed, 0.0, MaximumSpeed, "Speed", false);
 }
 
 //----------------------------------------------------------------------------

@@ -230,10 +230,10 @@ protected:
   vtkMRMLVolumeCutToolNode(const vtkMRMLVolumeCutToolNode&) = delete;
   void operator=(const vtkMRMLVolumeCutToolNode&) = delete;
 
-  /// Set a size if it is finite and within [minimum, maximum]; otherwise log
-  /// an error naming the property and keep the value. Returns whether the
-  /// value changed.
-  bool SetValidatedValue(double& member, double value, double minimum, double maximum, const char* property);
+  /// Set a value if it is finite and within [minimum, maximum]; otherwise log
+  /// an error naming the property and keep the value. A change of a geometry
+  /// property also invokes ToolGeometryModifiedEvent.
+  void SetValidatedValue(double& member, double value, double minimum, double maximum, const char* property, bool geometry);
 
   /// A new, changed or removed mesh reference changes what the tool removes.
   void OnNodeReferenceAdded(vtkMRMLNodeReference* reference) override;
