@@ -45,6 +45,19 @@ constexpr double ThicknessRange[2] = { 0.1, 5.0 };
 constexpr double WidthRange[2] = { 1.0, 50.0 };
 constexpr double MaximumSpeed = 150000.0;
 
+/// The value whose name is `name`, or -1: the inverse of an AsString function.
+int EnumFromString(const char* name, int count, const char* (*asString)(int))
+{
+  for (int value = 0; name && value < count; ++value)
+  {
+    if (!strcmp(name, asString(value)))
+    {
+      return value;
+    }
+  }
+  return -1;
+}
+
 bool Contains(const std::vector<std::string>& ids, const std::string& id)
 {
   return std::find(ids.begin(), ids.end(), id) != ids.end();
@@ -240,14 +253,7 @@ const char* vtkMRMLVolumeCutToolNode::GetShapeAsString(int shape)
 //----------------------------------------------------------------------------
 int vtkMRMLVolumeCutToolNode::GetShapeFromString(const char* name)
 {
-  for (int shape = 0; name && shape < Shape_Last; ++shape)
-  {
-    if (!strcmp(name, GetShapeAsString(shape)))
-    {
-      return shape;
-    }
-  }
-  return -1;
+  return EnumFromString(name, Shape_Last, &GetShapeAsString);
 }
 
 //----------------------------------------------------------------------------
@@ -283,14 +289,7 @@ const char* vtkMRMLVolumeCutToolNode::GetBurrTypeAsString(int burrType)
 //----------------------------------------------------------------------------
 int vtkMRMLVolumeCutToolNode::GetBurrTypeFromString(const char* name)
 {
-  for (int burrType = 0; name && burrType < BurrType_Last; ++burrType)
-  {
-    if (!strcmp(name, GetBurrTypeAsString(burrType)))
-    {
-      return burrType;
-    }
-  }
-  return -1;
+  return EnumFromString(name, BurrType_Last, &GetBurrTypeAsString);
 }
 
 //----------------------------------------------------------------------------
