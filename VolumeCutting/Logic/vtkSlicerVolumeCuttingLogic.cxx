@@ -14,6 +14,8 @@
 #include "vtkImageBoneSegmentation.h"
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkMRMLVolumeCutStorageNode.h"
+#include "vtkMRMLVolumeCutToolDisplayNode.h"
+#include "vtkMRMLVolumeCutToolNode.h"
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutMaterialRemoval.h"
@@ -167,6 +169,8 @@ void vtkSlicerVolumeCuttingLogic::RegisterNodes()
   }
   this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutNode>::New());
   this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutStorageNode>::New());
+  this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutToolNode>::New());
+  this->GetMRMLScene()->RegisterNodeClass(vtkSmartPointer<vtkMRMLVolumeCutToolDisplayNode>::New());
 }
 
 //----------------------------------------------------------------------------

@@ -3,15 +3,17 @@
 Thin by design: the widget only connects the GUI to VolumeCuttingToolsLogic, and
 the logic forwards to VolumeCuttingLib (Qt-free, tested with pytest against
 slicer-core) and to the C++ vtkSlicerVolumeCuttingLogic. Tool configuration
-(burrs, saws, sensibility) is added here as those tools are built.
+(presets, shape, burr type, sizes, drive, per-segment sensibility, input
+device) is VolumeCuttingLib.toolconfig; this file only shows it.
 """
 
 import logging
 from typing import Annotated
 
+import qt
 import slicer
 import vtk
-from slicer.parameterNodeWrapper import WithinRange, parameterNodeWrapper
+from slicer.parameterNodeWrapper import Choice, WithinRange, parameterNodeWrapper
 from slicer.ScriptedLoadableModule import (
     ScriptedLoadableModule,
     ScriptedLoadableModuleLogic,
@@ -20,7 +22,13 @@ from slicer.ScriptedLoadableModule import (
 )
 from slicer.util import VTKObservationMixin
 
-from VolumeCuttingLib import headct, phantom
+from VolumeCuttingLib import headct, phantom, toolconfig
+
+# Read once: the parameter node's choices are fixed when the module loads.
+TOOL_PRESETS = {preset.name: preset for preset in toolconfig.load_presets()}
+DEFAULT_TOOL = toolconfig.ToolParameters()
+# The widest diameter range (burrs to disk saws); toolconfig checks the shape's own.
+DIAMETER_LIMITS = (toolconfig.diameter_range("Sphere")[0], toolconfig.diameter_range("DiskSaw")[1])
 
 
 #
@@ -57,6 +65,14 @@ class VolumeCuttingToolsParameterNode:
     phantomSeed - noise seed; the same seed gives the same phantom.
     anatomyVolume - the CT the cut session works on.
     segmentation - its segmentation.
+    cutNode - the volume-cut session whose segment roles the tools follow.
+    toolNode - the cutting tool being configured.
+    toolPreset - the preset "Load preset" copies into the fields below.
+    toolShape, burrType - shape of the tool and kind of burr.
+    toolDiameter, toolLength, toolThickness, toolWidth - sizes in mm (which ones a shape uses: toolconfig.SHAPE_FIELDS).
+    toolPower - fraction of the handpiece's maximum power.
+    toolSpeed - revolutions (burrs, disk saws) or oscillations (blades) per minute.
+    inputDevice - device_id of the device that drives the tool (toolconfig.list_devices()).
     """
 
     phantomSize: Annotated[int, WithinRange(32, 256)] = 128
@@ -64,6 +80,18 @@ class VolumeCuttingToolsParameterNode:
     phantomSeed: Annotated[int, WithinRange(0, 2**31 - 1)] = 0
     anatomyVolume: slicer.vtkMRMLScalarVolumeNode
     segmentation: slicer.vtkMRMLSegmentationNode
+    cutNode: slicer.vtkMRMLVolumeCutNode
+    toolNode: slicer.vtkMRMLVolumeCutToolNode
+    toolPreset: Annotated[str, Choice(list(TOOL_PRESETS))] = next(iter(TOOL_PRESETS))
+    toolShape: Annotated[str, Choice(list(toolconfig.SHAPES))] = DEFAULT_TOOL.shape
+    burrType: Annotated[str, Choice(list(toolconfig.BURR_TYPES))] = DEFAULT_TOOL.burr_type
+    toolDiameter: Annotated[float, WithinRange(*DIAMETER_LIMITS)] = DEFAULT_TOOL.diameter
+    toolLength: Annotated[float, WithinRange(*toolconfig.RANGES["length"])] = DEFAULT_TOOL.length
+    toolThickness: Annotated[float, WithinRange(*toolconfig.RANGES["thickness"])] = DEFAULT_TOOL.thickness
+    toolWidth: Annotated[float, WithinRange(*toolconfig.RANGES["width"])] = DEFAULT_TOOL.width
+    toolPower: Annotated[float, WithinRange(*toolconfig.RANGES["power"])] = DEFAULT_TOOL.power
+    toolSpeed: Annotated[float, WithinRange(*toolconfig.RANGES["speed"])] = DEFAULT_TOOL.speed
+    inputDevice: str = "mouse"
 
 
 #
@@ -91,6 +119,14 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self.addObserver(slicer.mrmlScene, slicer.mrmlScene.EndCloseEvent, self.onSceneEndClose)
         self.ui.loadHeadCTButton.connect("clicked(bool)", self.onLoadHeadCT)
         self.ui.generatePhantomButton.connect("clicked(bool)", self.onGeneratePhantom)
+        self.ui.loadPresetButton.connect("clicked(bool)", self.onLoadPreset)
+        self.ui.createToolButton.connect("clicked(bool)", self.onCreateTool)
+        self.ui.applyToolButton.connect("clicked(bool)", self.onApplyTool)
+        self.ui.followRolesButton.connect("clicked(bool)", self.onFollowCutNodeRoles)
+        self.ui.sensibilityTable.connect("itemChanged(QTableWidgetItem*)", self.onSensibilityItemChanged)
+        self.ui.refreshDevicesButton.connect("clicked(bool)", self.onRefreshDevices)
+        self.ui.inputDeviceComboBox.connect("currentIndexChanged(int)", self.onInputDeviceChanged)
+        self.onRefreshDevices()
         self.initializeParameterNode()
 
     def cleanup(self) -> None:
@@ -103,6 +139,7 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         if self._parameterNode:
             self._parameterNode.disconnectGui(self._parameterNodeGuiTag)
             self._parameterNodeGuiTag = None
+            self.removeObserver(self._parameterNode, vtk.vtkCommand.ModifiedEvent, self._onParameterNodeModified)
 
     def onSceneStartClose(self, caller, event) -> None:
         self.setParameterNode(None)
@@ -113,13 +150,48 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
 
     def initializeParameterNode(self) -> None:
         self.setParameterNode(self.logic.getParameterNode())
+        # Select default nodes if nothing is selected yet.
+        if not self._parameterNode.cutNode:
+            self._parameterNode.cutNode = slicer.mrmlScene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+        if not self._parameterNode.toolNode:
+            self._parameterNode.toolNode = slicer.mrmlScene.GetFirstNodeByClass("vtkMRMLVolumeCutToolNode")
 
     def setParameterNode(self, inputParameterNode) -> None:
         if self._parameterNode:
             self._parameterNode.disconnectGui(self._parameterNodeGuiTag)
+            self.removeObserver(self._parameterNode, vtk.vtkCommand.ModifiedEvent, self._onParameterNodeModified)
         self._parameterNode = inputParameterNode
         if self._parameterNode:
             self._parameterNodeGuiTag = self._parameterNode.connectGui(self.ui)
+            self.addObserver(self._parameterNode, vtk.vtkCommand.ModifiedEvent, self._onParameterNodeModified)
+            self._onParameterNodeModified()
+            self._selectInputDevice()
+
+    def _onParameterNodeModified(self, caller=None, event=None) -> None:
+        p = self._parameterNode
+        self.ui.applyToolButton.enabled = p is not None and p.toolNode is not None
+        self.ui.followRolesButton.enabled = p is not None and p.toolNode is not None
+        self._updateSensibilityTable()
+
+    def _updateSensibilityTable(self) -> None:
+        p = self._parameterNode
+        rows = self.logic.sensibilityRows(p.cutNode, p.toolNode) if p else []
+        table = self.ui.sensibilityTable
+        wasBlocked = table.blockSignals(True)
+        table.setRowCount(len(rows))
+        for index, row in enumerate(rows):
+            nameItem = qt.QTableWidgetItem(row.name)
+            nameItem.setData(qt.Qt.UserRole, row.segment_id)
+            nameItem.setData(qt.Qt.DecorationRole, qt.QColor.fromRgbF(*row.color))
+            nameItem.setFlags(qt.Qt.ItemIsEnabled)
+            roleItem = qt.QTableWidgetItem(row.role or "-")
+            roleItem.setFlags(qt.Qt.ItemIsEnabled)
+            cutItem = qt.QTableWidgetItem("from tool" if row.from_tool else "from roles")
+            cutItem.setFlags(qt.Qt.ItemIsEnabled | qt.Qt.ItemIsUserCheckable if row.editable and p.toolNode else qt.Qt.ItemIsEnabled)
+            cutItem.setCheckState(qt.Qt.Checked if row.may_cut else qt.Qt.Unchecked)
+            for column, item in enumerate((nameItem, roleItem, cutItem)):
+                table.setItem(index, column, item)
+        table.blockSignals(wasBlocked)
 
     def onLoadHeadCT(self) -> None:
         with slicer.util.tryWithErrorDisplay("Failed to load the head CT.", waitCursor=True):
@@ -132,6 +204,50 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
             volume, segmentation = self.logic.generatePhantom(p.phantomSize, p.phantomSpacing, p.phantomSeed)
             p.anatomyVolume = volume
             p.segmentation = segmentation
+
+    def onLoadPreset(self) -> None:
+        with slicer.util.tryWithErrorDisplay("Failed to load the tool preset."):
+            self.logic.loadPreset(self._parameterNode)
+
+    def onCreateTool(self) -> None:
+        with slicer.util.tryWithErrorDisplay("Failed to create the tool."):
+            self._parameterNode.toolNode = self.logic.createTool(self._parameterNode)
+
+    def onApplyTool(self) -> None:
+        with slicer.util.tryWithErrorDisplay("Failed to configure the tool."):
+            self.logic.applyToTool(self._parameterNode)
+
+    def onFollowCutNodeRoles(self) -> None:
+        self._parameterNode.toolNode.SetUseCutNodeRoles(True)
+        self._updateSensibilityTable()
+
+    def onSensibilityItemChanged(self, item) -> None:
+        p = self._parameterNode
+        if item.column() != 2 or not p.toolNode:
+            return
+        segmentId = self.ui.sensibilityTable.item(item.row(), 0).data(qt.Qt.UserRole)
+        with slicer.util.tryWithErrorDisplay("Failed to change what the tool may cut."):
+            self.logic.setSegmentCuttableForTool(p.cutNode, p.toolNode, segmentId, item.checkState() == qt.Qt.Checked)
+        self._updateSensibilityTable()
+
+    def onRefreshDevices(self) -> None:
+        combo = self.ui.inputDeviceComboBox
+        wasBlocked = combo.blockSignals(True)
+        combo.clear()
+        for device in self.logic.listDevices():
+            combo.addItem(device.label, device.device_id)
+        combo.blockSignals(wasBlocked)
+        self._selectInputDevice()
+
+    def _selectInputDevice(self) -> None:
+        """Show the parameter node's device; one no longer plugged in falls back to the mouse."""
+        if self._parameterNode:
+            combo = self.ui.inputDeviceComboBox
+            combo.setCurrentIndex(max(combo.findData(self._parameterNode.inputDevice), 0))
+
+    def onInputDeviceChanged(self, index: int) -> None:
+        if self._parameterNode and index >= 0:
+            self._parameterNode.inputDevice = self.ui.inputDeviceComboBox.itemData(index)
 
 
 #
@@ -157,6 +273,41 @@ class VolumeCuttingToolsLogic(ScriptedLoadableModuleLogic):
         slicer.util.setSliceViewerLayers(background=volume, fit=True)
         return volume, segmentation
 
+    def toolParameters(self, parameterNode, baseline=None) -> toolconfig.ToolParameters:
+        """The parameter node's tool fields over ``baseline`` (sensibility and mesh are kept from it)."""
+        p = parameterNode
+        return (baseline or toolconfig.ToolParameters()).replace(
+            shape=p.toolShape, burr_type=p.burrType, diameter=p.toolDiameter, length=p.toolLength,
+            thickness=p.toolThickness, width=p.toolWidth, power=p.toolPower, speed=p.toolSpeed)
+
+    def loadPreset(self, parameterNode) -> None:
+        tool = toolconfig.from_preset(TOOL_PRESETS[parameterNode.toolPreset])
+        with slicer.util.NodeModify(parameterNode):
+            parameterNode.toolShape = tool.shape
+            parameterNode.burrType = tool.burr_type
+            parameterNode.toolDiameter = tool.diameter
+            parameterNode.toolLength = tool.length
+            parameterNode.toolThickness = tool.thickness
+            parameterNode.toolWidth = tool.width
+            parameterNode.toolPower = tool.power
+            parameterNode.toolSpeed = tool.speed
+
+    def createTool(self, parameterNode):
+        return toolconfig.create_tool_node(slicer.mrmlScene, self.toolParameters(parameterNode), parameterNode.toolPreset)
+
+    def applyToTool(self, parameterNode) -> None:
+        tool = parameterNode.toolNode
+        toolconfig.apply_to_tool_node(self.toolParameters(parameterNode, toolconfig.from_tool_node(tool)), tool)
+
+    def sensibilityRows(self, cutNode, toolNode):
+        return toolconfig.sensibility_rows(cutNode, toolNode)
+
+    def setSegmentCuttableForTool(self, cutNode, toolNode, segmentId: str, cuttable: bool) -> None:
+        toolconfig.set_segment_cuttable_for_tool(cutNode, toolNode, segmentId, cuttable)
+
+    def listDevices(self):
+        return toolconfig.list_devices()
+
 
 #
 # VolumeCuttingToolsTest
@@ -172,6 +323,8 @@ class VolumeCuttingToolsTest(ScriptedLoadableModuleTest):
     def runTest(self):
         self.setUp()
         self.test_PhantomAndBoneSegmentation()
+        self.setUp()
+        self.test_ToolConfiguration()
 
     def test_PhantomAndBoneSegmentation(self):
         self.delayDisplay("Generating a phantom")
@@ -185,4 +338,19 @@ class VolumeCuttingToolsTest(ScriptedLoadableModuleTest):
         cutNode = cuttingLogic.AddVolumeCutNode(volume, segmentation)
         self.assertTrue(cutNode.SetSegmentProtected("FacialNerve", True))
         self.assertTrue(cuttingLogic.CheckInputs(cutNode, slicer.vtkMRMLMessageCollection()))
+        self.delayDisplay("Test passed")
+
+    def test_ToolConfiguration(self):
+        self.delayDisplay("Configuring a tool from a preset")
+        logic = VolumeCuttingToolsLogic()
+        parameterNode = logic.getParameterNode()
+        parameterNode.toolPreset = "Diamond burr 2 mm"
+        logic.loadPreset(parameterNode)
+        tool = logic.createTool(parameterNode)
+        self.assertEqual(toolconfig.from_tool_node(tool), TOOL_PRESETS["Diamond burr 2 mm"].parameters)
+        parameterNode.toolNode = tool
+        parameterNode.toolDiameter = 3.0
+        logic.applyToTool(parameterNode)
+        self.assertEqual(tool.GetDiameter(), 3.0)
+        self.assertEqual(logic.listDevices()[0].device_id, "mouse")
         self.delayDisplay("Test passed")

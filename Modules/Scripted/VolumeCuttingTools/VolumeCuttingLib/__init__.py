@@ -14,6 +14,10 @@ Modules:
     benchmarks: the benchmark harness (one JSON per area).
     analyticscene: the mapper's accuracy scene (a cut cube) and its exact ray tracing and metrics.
     mapperbenchmarks: the ``mapper`` benchmark area (accuracy and frame times vs VTK's stock mapper).
+    toolconfig: cutting-tool parameters, presets, sensibility table and device choice, without Qt
+        (shared by the desktop module and a web application).
+    inputdevices: the mouse and the known haptic, 6-DoF and foot-switch devices plugged in
+        (hidapi and libusb through ctypes; standard library only).
 
 Submodules are not imported here so that the numpy-only parts stay usable
 without VTK or Slicer.

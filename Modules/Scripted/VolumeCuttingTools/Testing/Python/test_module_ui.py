@@ -1,0 +1,55 @@
+"""The desktop module's widget file against its .ui, without Qt.
+
+Desktop Slicer is not available here, so the checks that can be made without
+it are made statically: the module compiles, every ``SlicerParameterName`` in
+the .ui is a parameter of the parameter node, and every ``self.ui.<name>``
+the widget uses is a widget of the .ui.
+"""
+
+import ast
+import py_compile
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+MODULE_DIR = Path(__file__).resolve().parents[2]
+MODULE_FILE = MODULE_DIR / "VolumeCuttingTools.py"
+UI_FILE = MODULE_DIR / "Resources" / "UI" / "VolumeCuttingTools.ui"
+
+
+def parameter_names():
+    tree = ast.parse(MODULE_FILE.read_text())
+    parameter_class = next(node for node in tree.body if isinstance(node, ast.ClassDef) and node.name == "VolumeCuttingToolsParameterNode")
+    return {statement.target.id for statement in parameter_class.body if isinstance(statement, ast.AnnAssign)}
+
+
+def ui_widgets():
+    root = ElementTree.parse(UI_FILE).getroot()
+    widgets = {}
+    for widget in root.iter("widget"):
+        bound = None
+        for prop in widget.findall("property"):
+            if prop.get("name") == "SlicerParameterName":
+                bound = prop.findtext("string")
+        widgets[widget.get("name")] = (widget.get("class"), bound)
+    return widgets
+
+
+def test_module_compiles(tmp_path):
+    py_compile.compile(str(MODULE_FILE), cfile=str(tmp_path / "module.pyc"), doraise=True)
+
+
+def test_ui_parameters_exist_in_the_parameter_node():
+    parameters = parameter_names()
+    bound = {name: parameter for name, (_, parameter) in ui_widgets().items() if parameter}
+    assert set(bound.values()) <= parameters, set(bound.values()) - parameters
+    # Each parameter is shown by one widget at most.
+    assert len(set(bound.values())) == len(bound)
+    for parameter in ("toolPreset", "toolShape", "burrType", "toolDiameter", "toolPower", "toolSpeed", "cutNode", "toolNode"):
+        assert parameter in bound.values()
+
+
+def test_widgets_the_module_uses_are_in_the_ui():
+    used = {node.attr for node in ast.walk(ast.parse(MODULE_FILE.read_text()))
+            if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute) and node.value.attr == "ui"}
+    assert used, "no self.ui.<widget> found: the check would prove nothing"
+    assert used <= set(ui_widgets()), used - set(ui_widgets())
