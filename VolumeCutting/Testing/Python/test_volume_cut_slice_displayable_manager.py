@@ -98,6 +98,32 @@ def test_axial_outline_is_the_exact_circle(session):
     assert max_error < 0.1 * SPACING.min()
 
 
+def test_field_on_an_oblique_grid():
+    """The CT's grid rotated 30 degrees about S and tilted 20 degrees about R, x flipped: bricks cross the plane obliquely."""
+    application = HeadlessSlicer()
+    rotation = vtk.vtkTransform()
+    rotation.RotateZ(30.0)
+    rotation.RotateX(20.0)
+    matrix = nodes.vtk_matrix_to_numpy(rotation.GetMatrix()) @ np.diag([-SPACING[0], SPACING[1], SPACING[2], 1.0])
+    half = (np.array(DIMENSIONS) - 1) / 2.0
+    matrix[:3, 3] = -matrix[:3, :3] @ half
+    ct = np.full(DIMENSIONS[::-1], 1000, np.int16)
+    volume = nodes.create_scalar_volume_node(application.scene, ct, matrix, "ObliqueCT")
+    cut_node = application.volume_cutting_logic.AddVolumeCutNode(volume, None)
+    view = application.create_slice_view("Axial", VIEW_SIZE, VIEW_SIZE, "Red")
+    view.slice_node.SetFieldOfView(VIEW_SIZE * PIXEL, VIEW_SIZE * PIXEL, 1.0)
+    cut_sphere(application, cut_node)
+    for d in (0.0, 3.1):
+        center_axial_view(view, CENTER[2] + d)
+        ras, outline = outline_ras(view, cut_node)
+        assert outline.GetNumberOfPoints() > 50
+        radii = np.hypot(ras[:, 0] - CENTER[0], ras[:, 1] - CENTER[1])
+        max_error = np.max(np.abs(radii - math.sqrt(RADIUS**2 - d**2)))
+        print(f"oblique grid, axial plane at {d} mm: max error {max_error:.4f} mm")
+        assert max_error < 0.1 * SPACING.min()
+    view.close()
+
+
 def test_oblique_plane_and_fill_polygons(session):
     application, volume, cut_node, view = session
     cut_sphere(application, cut_node)
