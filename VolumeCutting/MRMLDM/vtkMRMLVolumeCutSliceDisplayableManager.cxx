@@ -499,6 +499,12 @@ struct vtkMRMLVolumeCutSliceDisplayableManager::Internals
 
   std::map<vtkMRMLVolumeCutNode*, Pipeline> Pipelines;
   vtkWeakPointer<vtkRenderer> ObservedRenderer;
+
+  Pipeline* Find(vtkMRMLVolumeCutNode* cutNode)
+  {
+    auto found = this->Pipelines.find(cutNode);
+    return found == this->Pipelines.end() ? nullptr : &found->second;
+  }
   unsigned long RenderObserverTag = 0;
   bool WarnedCoarseSampling = false;
 };
@@ -687,12 +693,12 @@ void vtkMRMLVolumeCutSliceDisplayableManager::OnRenderStart()
 //---------------------------------------------------------------------------
 void vtkMRMLVolumeCutSliceDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* cutNode)
 {
-  auto found = this->Impl->Pipelines.find(cutNode);
-  if (found == this->Impl->Pipelines.end())
+  Internals::Pipeline* found = this->Impl->Find(cutNode);
+  if (!found)
   {
     return;
   }
-  Internals::Pipeline& pipeline = found->second;
+  Internals::Pipeline& pipeline = *found;
   vtkMRMLSliceNode* sliceNode = this->GetMRMLSliceNode();
   vtkVolumeCutField* field = cutNode->GetCutField();
 
@@ -774,45 +780,45 @@ void vtkMRMLVolumeCutSliceDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNod
 //---------------------------------------------------------------------------
 vtkPolyData* vtkMRMLVolumeCutSliceDisplayableManager::GetOutline(vtkMRMLVolumeCutNode* cutNode)
 {
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
   this->UpdatePipeline(cutNode);
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? nullptr : found->second.Outline.GetPointer();
+  return pipeline ? pipeline->Outline.GetPointer() : nullptr;
 }
 
 //---------------------------------------------------------------------------
 vtkPolyData* vtkMRMLVolumeCutSliceDisplayableManager::GetFill(vtkMRMLVolumeCutNode* cutNode)
 {
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
   this->UpdatePipeline(cutNode);
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? nullptr : found->second.Fill.GetPointer();
+  return pipeline ? pipeline->Fill.GetPointer() : nullptr;
 }
 
 //---------------------------------------------------------------------------
 vtkActor2D* vtkMRMLVolumeCutSliceDisplayableManager::GetOutlineActor(vtkMRMLVolumeCutNode* cutNode)
 {
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
   this->UpdatePipeline(cutNode);
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? nullptr : found->second.OutlineActor.GetPointer();
+  return pipeline ? pipeline->OutlineActor.GetPointer() : nullptr;
 }
 
 //---------------------------------------------------------------------------
 vtkActor2D* vtkMRMLVolumeCutSliceDisplayableManager::GetFillActor(vtkMRMLVolumeCutNode* cutNode)
 {
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
   this->UpdatePipeline(cutNode);
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? nullptr : found->second.FillActor.GetPointer();
+  return pipeline ? pipeline->FillActor.GetPointer() : nullptr;
 }
 
 //---------------------------------------------------------------------------
 double vtkMRMLVolumeCutSliceDisplayableManager::GetSampleSpacing(vtkMRMLVolumeCutNode* cutNode)
 {
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? 0.0 : found->second.SampleSpacing;
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
+  return pipeline ? pipeline->SampleSpacing : 0.0;
 }
 
 //---------------------------------------------------------------------------
 vtkIdType vtkMRMLVolumeCutSliceDisplayableManager::GetNumberOfSamples(vtkMRMLVolumeCutNode* cutNode)
 {
-  auto found = this->Impl->Pipelines.find(cutNode);
-  return found == this->Impl->Pipelines.end() ? 0 : found->second.NumberOfSamples;
+  Internals::Pipeline* pipeline = this->Impl->Find(cutNode);
+  return pipeline ? pipeline->NumberOfSamples : 0;
 }

@@ -335,7 +335,7 @@ def test_a_reloaded_scene_shows_its_cut_in_slice_views(session, tmp_path):
     view.close()
 
 
-def test_slice_display_properties_survive_a_scene_round_trip():
+def test_slice_display_properties_survive_a_scene_round_trip(scene_xml_round_trip):
     scene = slicer.vtkMRMLScene()
     scene.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
     node = scene.AddNewNodeByClass("vtkMRMLVolumeCutNode")
@@ -346,22 +346,14 @@ def test_slice_display_properties_survive_a_scene_round_trip():
     node.SetSliceFillOpacity(0.55)
     node.SetSliceColor(0.1, 0.8, 0.25)
     node.SetSliceOutlineThickness(3.5)
-    scene.SetSaveToXMLString(1)
-    scene.Commit()
-    xml = scene.GetSceneXMLString()
-    reloaded = slicer.vtkMRMLScene()
-    reloaded.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
-    reloaded.SetLoadFromXMLString(1)
-    reloaded.SetSceneXMLString(xml)
-    reloaded.Import()
-    copy = reloaded.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    copy = scene_xml_round_trip(node)
     assert not copy.GetSliceOutlineVisibility()
     assert not copy.GetSliceFillVisibility()
     assert copy.GetSliceFillOpacity() == pytest.approx(0.55)
     assert copy.GetSliceColor() == pytest.approx((0.1, 0.8, 0.25))
     assert copy.GetSliceOutlineThickness() == pytest.approx(3.5)
     # Copies (scene undo, node duplication) carry them too.
-    duplicate = reloaded.AddNewNodeByClass("vtkMRMLVolumeCutNode")
+    duplicate = copy.GetScene().AddNewNodeByClass("vtkMRMLVolumeCutNode")
     duplicate.CopyContent(copy)
     assert duplicate.GetSliceColor() == pytest.approx((0.1, 0.8, 0.25))
     assert duplicate.GetSliceOutlineThickness() == pytest.approx(3.5)
