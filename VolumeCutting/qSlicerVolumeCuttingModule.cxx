@@ -16,6 +16,7 @@
 VTK_MODULE_INIT(vtkSlicerVolumeCuttingModuleMRMLDisplayableManager)
 
 // MRMLDisplayableManager includes
+#include <vtkMRMLSliceViewDisplayableManagerFactory.h>
 #include <vtkMRMLThreeDViewDisplayableManagerFactory.h>
 
 // VolumeCutting includes
@@ -89,6 +90,8 @@ void qSlicerVolumeCuttingModule::setup()
   this->Superclass::setup();
   // 3D views show volume-cut nodes through the adaptive multivolume mapper.
   vtkMRMLThreeDViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutDisplayableManager");
+  // Slice views outline and fill the cut region where they cut it.
+  vtkMRMLSliceViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutSliceDisplayableManager");
 }
 
 //-----------------------------------------------------------------------------

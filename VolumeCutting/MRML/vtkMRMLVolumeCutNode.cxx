@@ -132,6 +132,11 @@ void vtkMRMLVolumeCutNode::WriteXML(ostream& of, int nIndent)
   vtkMRMLWriteXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
   vtkMRMLWriteXMLBooleanMacro(thinBoneShading, ThinBoneShading);
   vtkMRMLWriteXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
+  vtkMRMLWriteXMLBooleanMacro(sliceOutlineVisibility, SliceOutlineVisibility);
+  vtkMRMLWriteXMLBooleanMacro(sliceFillVisibility, SliceFillVisibility);
+  vtkMRMLWriteXMLFloatMacro(sliceFillOpacity, SliceFillOpacity);
+  vtkMRMLWriteXMLVectorMacro(sliceColor, SliceColor, double, 3);
+  vtkMRMLWriteXMLFloatMacro(sliceOutlineThickness, SliceOutlineThickness);
   vtkMRMLWriteXMLEndMacro();
 }
 
@@ -147,6 +152,11 @@ void vtkMRMLVolumeCutNode::ReadXMLAttributes(const char** atts)
   vtkMRMLReadXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
   vtkMRMLReadXMLBooleanMacro(thinBoneShading, ThinBoneShading);
   vtkMRMLReadXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
+  vtkMRMLReadXMLBooleanMacro(sliceOutlineVisibility, SliceOutlineVisibility);
+  vtkMRMLReadXMLBooleanMacro(sliceFillVisibility, SliceFillVisibility);
+  vtkMRMLReadXMLFloatMacro(sliceFillOpacity, SliceFillOpacity);
+  vtkMRMLReadXMLVectorMacro(sliceColor, SliceColor, double, 3);
+  vtkMRMLReadXMLFloatMacro(sliceOutlineThickness, SliceOutlineThickness);
   vtkMRMLReadXMLEndMacro();
 }
 
@@ -179,6 +189,11 @@ void vtkMRMLVolumeCutNode::CopyContent(vtkMRMLNode* anode, bool deepCopy /*=true
   vtkMRMLCopyFloatMacro(SurfaceIsoValue);
   vtkMRMLCopyBooleanMacro(ThinBoneShading);
   vtkMRMLCopyFloatMacro(ThinBoneThickness);
+  vtkMRMLCopyBooleanMacro(SliceOutlineVisibility);
+  vtkMRMLCopyBooleanMacro(SliceFillVisibility);
+  vtkMRMLCopyFloatMacro(SliceFillOpacity);
+  vtkMRMLCopyVectorMacro(SliceColor, double, 3);
+  vtkMRMLCopyFloatMacro(SliceOutlineThickness);
   vtkMRMLCopyEndMacro();
 }
 
@@ -193,6 +208,11 @@ void vtkMRMLVolumeCutNode::PrintSelf(ostream& os, vtkIndent indent)
   vtkMRMLPrintFloatMacro(SurfaceIsoValue);
   vtkMRMLPrintBooleanMacro(ThinBoneShading);
   vtkMRMLPrintFloatMacro(ThinBoneThickness);
+  vtkMRMLPrintBooleanMacro(SliceOutlineVisibility);
+  vtkMRMLPrintBooleanMacro(SliceFillVisibility);
+  vtkMRMLPrintFloatMacro(SliceFillOpacity);
+  vtkMRMLPrintVectorMacro(SliceColor, double, 3);
+  vtkMRMLPrintFloatMacro(SliceOutlineThickness);
   vtkMRMLPrintEndMacro();
 }
 

@@ -157,6 +157,29 @@ public:
   ///@}
   ///@}
 
+  ///@{
+  /**
+   * How 2D slice views show the removed region where they cut it
+   * (vtkMRMLVolumeCutSliceDisplayableManager): its outline where the slice
+   * plane meets the cut surface, SliceOutlineThickness pixels wide (default
+   * 2), and a fill of the removed part of the plane at SliceFillOpacity
+   * (default 0.3), both in SliceColor (default a clear red, 1, 0.15, 0.1).
+   * Outline and fill are visible by default.
+   */
+  vtkSetMacro(SliceOutlineVisibility, bool);
+  vtkGetMacro(SliceOutlineVisibility, bool);
+  vtkBooleanMacro(SliceOutlineVisibility, bool);
+  vtkSetMacro(SliceFillVisibility, bool);
+  vtkGetMacro(SliceFillVisibility, bool);
+  vtkBooleanMacro(SliceFillVisibility, bool);
+  vtkSetClampMacro(SliceFillOpacity, double, 0.0, 1.0);
+  vtkGetMacro(SliceFillOpacity, double);
+  vtkSetVector3Macro(SliceColor, double);
+  vtkGetVector3Macro(SliceColor, double);
+  vtkSetClampMacro(SliceOutlineThickness, double, 0.1, 100.0);
+  vtkGetMacro(SliceOutlineThickness, double);
+  ///@}
+
 protected:
   vtkMRMLVolumeCutNode();
   ~vtkMRMLVolumeCutNode() override;
@@ -178,6 +201,12 @@ protected:
   double SurfaceIsoValue{ 300.0 };
   bool ThinBoneShading{ false };
   double ThinBoneThickness{ 1.0 };
+
+  bool SliceOutlineVisibility{ true };
+  bool SliceFillVisibility{ true };
+  double SliceFillOpacity{ 0.3 };
+  double SliceColor[3]{ 1.0, 0.15, 0.1 };
+  double SliceOutlineThickness{ 2.0 };
 };
 
 #endif

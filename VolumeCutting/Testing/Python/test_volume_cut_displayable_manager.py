@@ -94,22 +94,14 @@ def test_view_shows_the_cut_node_and_follows_cuts(session):
     assert view.renderer.GetVolumes().GetNumberOfItems() == 0
 
 
-def test_rendering_settings_are_saved_with_the_node():
+def test_rendering_settings_are_saved_with_the_node(scene_xml_round_trip):
     scene = slicer.vtkMRMLScene()
     scene.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
     node = scene.AddNewNodeByClass("vtkMRMLVolumeCutNode")
     node.SetSurfaceIsoValue(412.5)
     node.SetThinBoneShading(True)
     node.SetThinBoneThickness(1.75)
-    scene.SetSaveToXMLString(1)
-    scene.Commit()
-    xml = scene.GetSceneXMLString()
-    reloaded = slicer.vtkMRMLScene()
-    reloaded.RegisterNodeClass(slicer.vtkMRMLVolumeCutNode())
-    reloaded.SetLoadFromXMLString(1)
-    reloaded.SetSceneXMLString(xml)
-    reloaded.Import()
-    copy = reloaded.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+    copy = scene_xml_round_trip(node)
     assert copy.GetSurfaceIsoValue() == pytest.approx(412.5)
     assert copy.GetThinBoneShading()
     assert copy.GetThinBoneThickness() == pytest.approx(1.75)

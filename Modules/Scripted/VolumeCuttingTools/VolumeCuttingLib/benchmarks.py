@@ -488,10 +488,17 @@ def mapper(repeats: int) -> list[dict]:
     return mapperbenchmarks.mapper(repeats)
 
 
+def sliceview(repeats: int) -> list[dict]:
+    from . import slicebenchmarks
+
+    return slicebenchmarks.sliceview(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
+    "sliceview": sliceview,
 }
 
 
