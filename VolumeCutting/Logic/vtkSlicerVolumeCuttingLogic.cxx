@@ -18,12 +18,16 @@
 #include "vtkMRMLVolumeCutToolNode.h"
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutBoxTool.h"
+#include "vtkVolumeCutCylinderTool.h"
 #include "vtkVolumeCutMaterialRemoval.h"
+#include "vtkVolumeCutMeshTool.h"
 #include "vtkVolumeCutRemovedVoxels.h"
 
 // MRML includes
 #include <vtkMRMLMessageCollection.h>
 #include <vtkMRMLModelDisplayNode.h>
+#include <vtkMRMLLinearTransformNode.h>
 #include <vtkMRMLModelNode.h>
 #include <vtkMRMLScalarVolumeNode.h>
 #include <vtkMRMLScene.h>
@@ -380,6 +384,8 @@ void vtkSlicerVolumeCuttingLogic::ForgetNode(const std::string& nodeId)
   this->SegmentLayers.erase(nodeId);
   this->ShieldedSegments.erase(nodeId);
   this->ReportedContactDepths.erase(nodeId);
+  this->CuttingTools.erase(nodeId);
+  this->StrokePoses.erase(nodeId);
 }
 
 //----------------------------------------------------------------------------
@@ -392,6 +398,8 @@ void vtkSlicerVolumeCuttingLogic::ForgetAllNodes()
   this->SegmentLayers.clear();
   this->ShieldedSegments.clear();
   this->ReportedContactDepths.clear();
+  this->CuttingTools.clear();
+  this->StrokePoses.clear();
 }
 
 //----------------------------------------------------------------------------
@@ -544,18 +552,21 @@ void vtkSlicerVolumeCuttingLogic::ClearCut(vtkMRMLVolumeCutNode* cutNode)
 //----------------------------------------------------------------------------
 std::vector<std::string> vtkSlicerVolumeCuttingLogic::GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode)
 {
-  // Tool sensibility: a tool affects only cuttable segments.
+  // Tool sensibility: a tool affects only what it may cut (the active
+  // tool's own list, or the cuttable roles).
   std::vector<std::string> shielded;
   vtkMRMLSegmentationNode* segmentationNode = cutNode ? cutNode->GetSegmentationNode() : nullptr;
   if (!segmentationNode)
   {
     return shielded;
   }
+  vtkMRMLVolumeCutToolNode* tool = GetActiveTool(cutNode);
   std::vector<std::string> segmentIds;
   segmentationNode->GetSegmentation()->GetSegmentIDs(segmentIds);
   for (const std::string& id : segmentIds)
   {
-    if (!cutNode->IsSegmentCuttable(id) && !cutNode->IsSegmentProtected(id))
+    const bool mayCut = tool ? tool->MayCutSegment(cutNode, id) : cutNode->IsSegmentCuttable(id);
+    if (!mayCut && !cutNode->IsSegmentProtected(id))
     {
       shielded.push_back(id);
     }
@@ -770,6 +781,8 @@ bool vtkSlicerVolumeCuttingLogic::BeginStroke(vtkMRMLVolumeCutNode* cutNode)
   // Contacts are reported per stroke.
   field->ResetContact();
   this->ReportedContactDepths[cutNode->GetID()] = 0.0;
+  // A stroke of the active tool starts where its first pose puts it.
+  this->StrokePoses.erase(cutNode->GetID());
   field->BeginStroke();
   return true;
 }
@@ -869,6 +882,170 @@ bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
   this->RecordContact(cutNode, field);
   this->UpdateTablesAfterChange(cutNode);
   return true;
+}
+
+//----------------------------------------------------------------------------
+vtkMRMLVolumeCutToolNode* vtkSlicerVolumeCuttingLogic::GetActiveTool(vtkMRMLVolumeCutNode* cutNode)
+{
+  return cutNode ? vtkMRMLVolumeCutToolNode::SafeDownCast(cutNode->GetActiveToolNode()) : nullptr;
+}
+
+//----------------------------------------------------------------------------
+vtkVolumeCutTool* vtkSlicerVolumeCuttingLogic::GetCuttingTool(vtkMRMLVolumeCutToolNode* toolNode)
+{
+  if (!toolNode || !toolNode->GetID() || toolNode->GetShape() == vtkMRMLVolumeCutToolNode::Sphere)
+  {
+    return nullptr;
+  }
+  vtkMTimeType time = toolNode->GetMTime();
+  vtkMRMLModelNode* model = toolNode->GetMeshModelNode();
+  if (model && model->GetPolyData())
+  {
+    time = std::max(time, model->GetPolyData()->GetMTime());
+  }
+  auto& cached = this->CuttingTools[toolNode->GetID()];
+  if (cached.second && cached.first == time)
+  {
+    return cached.second;
+  }
+  vtkSmartPointer<vtkVolumeCutTool> tool;
+  switch (toolNode->GetShape())
+  {
+    case vtkMRMLVolumeCutToolNode::Cylinder:
+    case vtkMRMLVolumeCutToolNode::DiskSaw:
+    {
+      auto cylinder = vtkSmartPointer<vtkVolumeCutCylinderTool>::New();
+      cylinder->SetRadius(0.5 * toolNode->GetDiameter());
+      // A disk saw is a cylinder as long as its blade is thick.
+      cylinder->SetLength(toolNode->GetShape() == vtkMRMLVolumeCutToolNode::DiskSaw ? toolNode->GetThickness() : toolNode->GetLength());
+      tool = cylinder;
+      break;
+    }
+    case vtkMRMLVolumeCutToolNode::Blade:
+    {
+      auto box = vtkSmartPointer<vtkVolumeCutBoxTool>::New();
+      box->SetSize(toolNode->GetWidth(), toolNode->GetThickness(), toolNode->GetLength());
+      tool = box;
+      break;
+    }
+    case vtkMRMLVolumeCutToolNode::Mesh:
+    {
+      if (!model || !model->GetPolyData() || model->GetPolyData()->GetNumberOfCells() == 0)
+      {
+        vtkErrorMacro("GetCuttingTool: the mesh tool '" << (toolNode->GetName() ? toolNode->GetName() : "") << "' has no model with a surface");
+        return nullptr;
+      }
+      auto mesh = vtkSmartPointer<vtkVolumeCutMeshTool>::New();
+      mesh->SetSurface(model->GetPolyData());
+      tool = mesh;
+      break;
+    }
+    default:
+      return nullptr;
+  }
+  if (!tool->IsValid())
+  {
+    vtkErrorMacro("GetCuttingTool: the tool '" << (toolNode->GetName() ? toolNode->GetName() : "") << "' does not describe a valid tool");
+    return nullptr;
+  }
+  cached = { time, tool };
+  return tool;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::SweepActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, bool cut)
+{
+  vtkMRMLVolumeCutToolNode* toolNode = GetActiveTool(cutNode);
+  if (!toolNode)
+  {
+    vtkErrorMacro("SweepActiveTool: the volume-cut node '" << (cutNode && cutNode->GetName() ? cutNode->GetName() : "")
+                                                          << "' has no active tool node; nothing was cut");
+    return false;
+  }
+  if (!pose0 || !pose1)
+  {
+    vtkErrorMacro("SweepActiveTool: a tool pose is missing; nothing was cut");
+    return false;
+  }
+  if (toolNode->GetShape() == vtkMRMLVolumeCutToolNode::Sphere)
+  {
+    // A sphere's sweep is a capsule whatever the rotation: the fast exact path.
+    const double p0[3] = { pose0->GetElement(0, 3), pose0->GetElement(1, 3), pose0->GetElement(2, 3) };
+    const double p1[3] = { pose1->GetElement(0, 3), pose1->GetElement(1, 3), pose1->GetElement(2, 3) };
+    const double radius = toolNode->GetCuttingRadius();
+    return cut ? this->CutSphereSweep(cutNode, p0, p1, radius) : this->RestoreSphereSweep(cutNode, p0, p1, radius);
+  }
+  vtkVolumeCutTool* tool = this->GetCuttingTool(toolNode);
+  if (!tool)
+  {
+    return false;
+  }
+  return cut ? this->CutToolSweep(cutNode, tool, pose0, pose1) : this->RestoreToolSweep(cutNode, tool, pose0, pose1);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::CutWithActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  return this->SweepActiveTool(cutNode, pose0, pose1, true);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::RestoreWithActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
+{
+  return this->SweepActiveTool(cutNode, pose0, pose1, false);
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* toolToRAS, int action)
+{
+  vtkMRMLVolumeCutToolNode* toolNode = GetActiveTool(cutNode);
+  if (!toolNode || !toolToRAS || !cutNode->GetID())
+  {
+    vtkErrorMacro("MoveActiveTool: a volume-cut node with an active tool node and a pose are required");
+    return false;
+  }
+  for (int element = 0; element < 16; ++element)
+  {
+    if (!std::isfinite(toolToRAS->GetElement(element / 4, element % 4)))
+    {
+      vtkErrorMacro("MoveActiveTool: the pose of '" << (toolNode->GetName() ? toolNode->GetName() : "") << "' is not finite; the tool did not move");
+      return false;
+    }
+  }
+  // The tool's glyph follows in every view.
+  vtkMRMLLinearTransformNode* transform = vtkMRMLLinearTransformNode::SafeDownCast(toolNode->GetParentTransformNode());
+  if (transform)
+  {
+    transform->SetMatrixTransformToParent(toolToRAS);
+  }
+  vtkVolumeCutField* field = cutNode->GetCutField();
+  bool accepted = true;
+  if (action != ToolMove && field && field->IsStrokeOpen())
+  {
+    // The first pose of a stroke cuts where it is; the next ones sweep from the last.
+    vtkSmartPointer<vtkMatrix4x4>& previous = this->StrokePoses[cutNode->GetID()];
+    accepted = this->SweepActiveTool(cutNode, previous ? previous.GetPointer() : toolToRAS, toolToRAS, action == ToolCut);
+    if (!previous)
+    {
+      previous = vtkSmartPointer<vtkMatrix4x4>::New();
+    }
+    previous->DeepCopy(toolToRAS);
+  }
+  return accepted;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::DrillWithActiveTool(vtkMRMLVolumeCutNode* cutNode, const double center[3], const double axis[3], double dt)
+{
+  vtkMRMLVolumeCutToolNode* toolNode = GetActiveTool(cutNode);
+  if (!toolNode)
+  {
+    vtkErrorMacro("DrillWithActiveTool: the volume-cut node has no active tool node");
+    return false;
+  }
+  // The rate follows the pedal: power scales the time the burr works.
+  return this->DrillWithMaterialRemoval(cutNode, center, axis, toolNode->GetCuttingRadius(), dt * toolNode->GetPower(),
+    toolNode->GetBurrType() == vtkMRMLVolumeCutToolNode::Diamond ? vtkVolumeCutMaterialRemoval::DiamondBurr : vtkVolumeCutMaterialRemoval::CuttingBurr);
 }
 
 //----------------------------------------------------------------------------

@@ -41,6 +41,7 @@ class vtkVolumeCutField;
 class vtkVolumeCutMaterialRemoval;
 class vtkVolumeCutRemovedVoxels;
 class vtkVolumeCutTool;
+class vtkMRMLVolumeCutToolNode;
 
 /// \brief Builds and checks volume-cutting sessions.
 ///
@@ -102,8 +103,9 @@ public:
   void ClearCut(vtkMRMLVolumeCutNode* cutNode);
 
   /// Segments kept out of cutting, in label order (label n is element n - 1):
-  /// those without a role first, then the protected ones, so that where
-  /// segments overlap a protected one names the voxel.
+  /// those the active tool may not cut (by default: those without a
+  /// cuttable role) first, then the protected ones, so that where segments
+  /// overlap a protected one names the voxel.
   static std::vector<std::string> GetShieldedSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
 
   ///@{
@@ -130,6 +132,36 @@ public:
   /// accumulates per node until ResetMaterialRemoval or a new cut field.
   bool DrillWithMaterialRemoval(vtkMRMLVolumeCutNode* cutNode, const double center[3], const double axis[3], double radius, double dt, int burrType);
   void ResetMaterialRemoval(vtkMRMLVolumeCutNode* cutNode);
+  /// Strokes of the cut node's active tool node (vtkMRMLVolumeCutToolNode):
+  /// its shape and sizes sweep rigidly from pose0 to pose1 (tool-to-RAS, in
+  /// the tool's frame as the tool node documents it); a spherical burr sweeps
+  /// as a capsule. What it may remove follows its sensibility (its own list
+  /// of cuttable segments, or the cut node's roles): the shield is rebuilt
+  /// from a table when the active tool or its list changes. Return false,
+  /// with the reason in the log, without an active tool or a valid pose.
+  bool CutWithActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+  bool RestoreWithActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+  /// What MoveActiveTool does along the way from the previous pose.
+  enum ToolAction
+  {
+    ToolMove = 0,
+    ToolCut,
+    ToolRestore
+  };
+  /// Move the active tool to a pose, from any source (mouse, haptic device,
+  /// replay): its transform node follows (views draw the tool there), and
+  /// inside a stroke the tool cuts or restores along the way from its
+  /// previous pose in the stroke. Returns false, with the reason in the log,
+  /// without an active tool or for a pose that is not a rigid motion.
+  bool MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* toolToRAS, int action);
+  /// Drill with rate-based material removal (see DrillWithMaterialRemoval)
+  /// using the active tool's cutting radius, burr type and power (which scales the rate).
+  bool DrillWithActiveTool(vtkMRMLVolumeCutNode* cutNode, const double center[3], const double axis[3], double dt);
+  /// The cut node's active tool node, or nullptr.
+  static vtkMRMLVolumeCutToolNode* GetActiveTool(vtkMRMLVolumeCutNode* cutNode);
+  /// The cutting tool a non-spherical tool node describes (rebuilt when its
+  /// geometry changes); nullptr for a spherical burr or a mesh tool without mesh.
+  vtkVolumeCutTool* GetCuttingTool(vtkMRMLVolumeCutToolNode* toolNode);
   bool UndoStroke(vtkMRMLVolumeCutNode* cutNode);
   bool RedoStroke(vtkMRMLVolumeCutNode* cutNode);
   ///@}
@@ -281,6 +313,13 @@ protected:
   void RecordContact(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
   /// A table referenced by the cut node under a role, created with its columns on first use.
   vtkMRMLTableNode* GetReferencedTable(vtkMRMLVolumeCutNode* cutNode, const char* role, const char* nameSuffix, const std::vector<std::string>& columns);
+
+  /// Sweep the active tool between two poses (cut or restore).
+  bool SweepActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, bool cut);
+  /// Cutting tools by tool-node ID, with the node modification time they match.
+  std::map<std::string, std::pair<vtkMTimeType, vtkSmartPointer<vtkVolumeCutTool>>> CuttingTools;
+  /// The active tool's last pose in the open stroke, per cut-node ID.
+  std::map<std::string, vtkSmartPointer<vtkMatrix4x4>> StrokePoses;
 
   /// Rate-based removal state per cut-node ID (its field and anatomy are inputs).
   std::map<std::string, vtkSmartPointer<vtkVolumeCutMaterialRemoval>> MaterialRemovals;

@@ -40,6 +40,8 @@ def _write_screenshot(render_window, path: str | Path) -> Path:
     grabber = vtk.vtkWindowToImageFilter()
     grabber.SetInput(render_window)
     grabber.ReadFrontBufferOff()
+    # The caller has just rendered: reading the buffer must not draw a frame again.
+    grabber.ShouldRerenderOff()
     grabber.Update()
     writer = vtk.vtkPNGWriter()
     writer.SetFileName(str(path))
@@ -174,6 +176,8 @@ class ThreeDView:
 
     def renderer_description(self) -> str:
         """The OpenGL renderer in use (for example llvmpipe, or a GPU's name)."""
+        if not self.render_window.GetNeverRendered():
+            return opengl_renderer_name(self.render_window)
         self.render()
         return opengl_renderer_name(self.render_window)
 
