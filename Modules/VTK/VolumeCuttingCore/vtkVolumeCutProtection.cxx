@@ -270,27 +270,42 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
     upper[axis] = own[axis][BrickSize - 1] + this->Reach[axis];
     size[axis] = upper[axis] - lower[axis] + 1;
   }
+  Scratch& scratch = this->BuildScratch;
   const size_t blockCount = static_cast<size_t>(size[0]) * size[1] * size[2];
-  std::vector<uint8_t> labels(blockCount);
-  this->GetShieldLabels(lower, upper, labels.data());
-  if (std::none_of(labels.begin(), labels.end(), [](uint8_t label) { return label != 0; }))
+  scratch.Labels.resize(blockCount);
+  uint8_t* labels = scratch.Labels.data();
+  this->GetShieldLabels(lower, upper, labels);
+  if (std::none_of(labels, labels + blockCount, [](uint8_t label) { return label != 0; }))
   {
     return nullptr; // nothing shielded within the band: the tool cuts freely
   }
   auto labelAt = [&](int x, int y, int z) { return labels[(static_cast<size_t>(z) * size[1] + y) * size[0] + x]; };
 
+  // Which distances are needed: to shielded cubes from samples outside them,
+  // to free cubes from samples inside.
+  bool needed[2] = { false, false };
+  for (int p = 0; p < BrickSize; ++p)
+  {
+    for (int m = 0; m < BrickSize; ++m)
+    {
+      for (int n = 0; n < BrickSize; ++n)
+      {
+        needed[labelAt(own[0][n] - lower[0], own[1][m] - lower[1], own[2][p] - lower[2]) != 0 ? 1 : 0] = true;
+      }
+    }
+  }
+
   // Squared distance along one axis from a sample to a voxel cube (cubes
   // span the voxel's index +-0.5).
-  std::vector<double> along[3];
   for (int axis = 0; axis < 3; ++axis)
   {
-    along[axis].resize(static_cast<size_t>(BrickSize) * size[axis]);
+    scratch.Along[axis].resize(static_cast<size_t>(BrickSize) * size[axis]);
     for (int n = 0; n < BrickSize; ++n)
     {
       for (int c = 0; c < size[axis]; ++c)
       {
-        const double excess = std::max(0.0, std::abs(position[axis][n] - (lower[axis] + c)) - 0.5) * this->AnatomySpacing[axis];
-        along[axis][static_cast<size_t>(n) * size[axis] + c] = excess * excess;
+        const float excess = static_cast<float>(std::max(0.0, std::abs(position[axis][n] - (lower[axis] + c)) - 0.5) * this->AnatomySpacing[axis]);
+        scratch.Along[axis][static_cast<size_t>(n) * size[axis] + c] = excess * excess;
       }
     }
   }
@@ -298,89 +313,126 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
   // The distance to a union of cubes is a minimum over a product of axes, so
   // it separates: min over x, then over y, then over z, each with its own
   // sample positions (Saito and Toriwaki's decomposition on the cubes'
-  // per-axis excess). Once for the shielded voxels (seen from samples
-  // outside them), once for the free ones (from samples inside).
-  constexpr double Far = std::numeric_limits<double>::max();
-  std::vector<double> passX(static_cast<size_t>(size[2]) * size[1] * BrickSize);
-  std::vector<uint8_t> labelX(passX.size());
-  std::vector<double> passY(static_cast<size_t>(size[2]) * BrickSize * BrickSize);
-  std::vector<uint8_t> labelY(passY.size());
-  double nearest[2][Brick::Samples];
+  // per-axis excess). Rows, columns and slices holding none of the wanted
+  // cubes are skipped: near a long thin structure most are empty.
+  constexpr float Far = std::numeric_limits<float>::max();
+  scratch.PassX.resize(static_cast<size_t>(size[2]) * size[1] * BrickSize);
+  scratch.LabelX.resize(scratch.PassX.size());
+  scratch.PassY.resize(static_cast<size_t>(size[2]) * BrickSize * BrickSize);
+  scratch.LabelY.resize(scratch.PassY.size());
+  scratch.Wanted.resize(static_cast<size_t>(size[0]));
+  scratch.RowFound.resize(static_cast<size_t>(size[2]) * size[1]);
+  scratch.SliceFound.resize(static_cast<size_t>(size[2]));
+  float nearest[2][Brick::Samples];
   uint8_t nearestLabel[Brick::Samples];
   for (int set = 0; set < 2; ++set)
   {
+    if (!needed[set])
+    {
+      continue;
+    }
     const bool towardShielded = set == 0;
     for (int z = 0; z < size[2]; ++z)
     {
+      bool sliceFound = false;
       for (int y = 0; y < size[1]; ++y)
       {
+        int wantedCount = 0;
+        const uint8_t* row = labels + (static_cast<size_t>(z) * size[1] + y) * size[0];
+        for (int x = 0; x < size[0]; ++x)
+        {
+          if ((row[x] != 0) == towardShielded)
+          {
+            scratch.Wanted[wantedCount++] = x;
+          }
+        }
+        const size_t rowIndex = static_cast<size_t>(z) * size[1] + y;
+        scratch.RowFound[rowIndex] = wantedCount > 0;
+        sliceFound |= wantedCount > 0;
+        float* out = &scratch.PassX[rowIndex * BrickSize];
+        uint8_t* outLabel = &scratch.LabelX[rowIndex * BrickSize];
         for (int n = 0; n < BrickSize; ++n)
         {
-          double best = Far;
+          const float* cost = &scratch.Along[0][static_cast<size_t>(n) * size[0]];
+          float best = Far;
           uint8_t bestLabel = 0;
-          const double* cost = &along[0][static_cast<size_t>(n) * size[0]];
-          for (int x = 0; x < size[0]; ++x)
+          for (int w = 0; w < wantedCount; ++w)
           {
-            const uint8_t label = labelAt(x, y, z);
-            if ((label != 0) == towardShielded && cost[x] < best)
+            const int x = scratch.Wanted[w];
+            if (cost[x] < best)
             {
               best = cost[x];
-              bestLabel = label;
+              bestLabel = row[x];
             }
           }
-          const size_t index = (static_cast<size_t>(z) * size[1] + y) * BrickSize + n;
-          passX[index] = best;
-          labelX[index] = bestLabel;
+          out[n] = best;
+          outLabel[n] = bestLabel;
         }
       }
+      scratch.SliceFound[z] = sliceFound;
     }
     for (int z = 0; z < size[2]; ++z)
     {
       for (int m = 0; m < BrickSize; ++m)
       {
-        const double* cost = &along[1][static_cast<size_t>(m) * size[1]];
-        for (int n = 0; n < BrickSize; ++n)
+        const float* cost = &scratch.Along[1][static_cast<size_t>(m) * size[1]];
+        float* out = &scratch.PassY[(static_cast<size_t>(z) * BrickSize + m) * BrickSize];
+        uint8_t* outLabel = &scratch.LabelY[(static_cast<size_t>(z) * BrickSize + m) * BrickSize];
+        std::fill(out, out + BrickSize, Far);
+        std::fill(outLabel, outLabel + BrickSize, uint8_t(0));
+        if (!scratch.SliceFound[z])
         {
-          double best = Far;
-          uint8_t bestLabel = 0;
-          for (int y = 0; y < size[1]; ++y)
+          continue;
+        }
+        for (int y = 0; y < size[1]; ++y)
+        {
+          const size_t rowIndex = static_cast<size_t>(z) * size[1] + y;
+          if (!scratch.RowFound[rowIndex])
           {
-            const size_t from = (static_cast<size_t>(z) * size[1] + y) * BrickSize + n;
-            if (passX[from] < Far && cost[y] + passX[from] < best)
+            continue;
+          }
+          const float* from = &scratch.PassX[rowIndex * BrickSize];
+          const uint8_t* fromLabel = &scratch.LabelX[rowIndex * BrickSize];
+          for (int n = 0; n < BrickSize; ++n)
+          {
+            const float candidate = cost[y] + from[n];
+            if (candidate < out[n])
             {
-              best = cost[y] + passX[from];
-              bestLabel = labelX[from];
+              out[n] = candidate;
+              outLabel[n] = fromLabel[n];
             }
           }
-          const size_t index = (static_cast<size_t>(z) * BrickSize + m) * BrickSize + n;
-          passY[index] = best;
-          labelY[index] = bestLabel;
         }
       }
     }
     for (int p = 0; p < BrickSize; ++p)
     {
-      const double* cost = &along[2][static_cast<size_t>(p) * size[2]];
-      for (int m = 0; m < BrickSize; ++m)
+      const float* cost = &scratch.Along[2][static_cast<size_t>(p) * size[2]];
+      float* out = nearest[set] + p * BrickSize * BrickSize;
+      uint8_t* outLabel = nearestLabel + p * BrickSize * BrickSize;
+      std::fill(out, out + BrickSize * BrickSize, Far);
+      if (towardShielded)
       {
-        for (int n = 0; n < BrickSize; ++n)
+        std::fill(outLabel, outLabel + BrickSize * BrickSize, uint8_t(0));
+      }
+      for (int z = 0; z < size[2]; ++z)
+      {
+        if (!scratch.SliceFound[z])
         {
-          double best = Far;
-          uint8_t bestLabel = 0;
-          for (int z = 0; z < size[2]; ++z)
+          continue;
+        }
+        const float* from = &scratch.PassY[static_cast<size_t>(z) * BrickSize * BrickSize];
+        const uint8_t* fromLabel = &scratch.LabelY[static_cast<size_t>(z) * BrickSize * BrickSize];
+        for (int mn = 0; mn < BrickSize * BrickSize; ++mn)
+        {
+          const float candidate = cost[z] + from[mn];
+          if (candidate < out[mn])
           {
-            const size_t from = (static_cast<size_t>(z) * BrickSize + m) * BrickSize + n;
-            if (passY[from] < Far && cost[z] + passY[from] < best)
+            out[mn] = candidate;
+            if (towardShielded)
             {
-              best = cost[z] + passY[from];
-              bestLabel = labelY[from];
+              outLabel[mn] = fromLabel[mn];
             }
-          }
-          const int local = (p * BrickSize + m) * BrickSize + n;
-          nearest[set][local] = best;
-          if (towardShielded)
-          {
-            nearestLabel[local] = bestLabel;
           }
         }
       }
@@ -400,8 +452,8 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
         const uint8_t ownLabel = labelAt(own[0][n] - lower[0], own[1][m] - lower[1], own[2][p] - lower[2]);
         // Inside: the distance to the nearest free cube; outside: to the
         // nearest shielded one. Voxels beyond the box are beyond the band.
-        const double squared = nearest[ownLabel != 0 ? 1 : 0][local];
-        const double distance = squared == Far ? this->BandWidth : std::min(this->BandWidth, std::sqrt(squared));
+        const float squared = nearest[ownLabel != 0 ? 1 : 0][local];
+        const double distance = squared >= Far ? this->BandWidth : std::min(this->BandWidth, std::sqrt(static_cast<double>(squared)));
         const double signedDistance = ownLabel != 0 ? -distance : distance;
         brick->Distance[local] = static_cast<int16_t>(std::lround(signedDistance * inverseQuantum));
         brick->Label[local] = ownLabel != 0 ? ownLabel : nearestLabel[local];

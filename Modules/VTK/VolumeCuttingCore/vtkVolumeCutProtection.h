@@ -144,6 +144,21 @@ protected:
   std::unordered_map<vtkIdType, std::unique_ptr<Brick>> Bricks;
   vtkIdType NumberOfShieldBricks = 0;
 
+  /// BuildBrick's working memory, kept between bricks (built by the writer only).
+  struct Scratch
+  {
+    std::vector<uint8_t> Labels;
+    std::vector<float> Along[3];
+    std::vector<float> PassX;
+    std::vector<uint8_t> LabelX;
+    std::vector<float> PassY;
+    std::vector<uint8_t> LabelY;
+    std::vector<int> Wanted;
+    std::vector<uint8_t> RowFound;
+    std::vector<uint8_t> SliceFound;
+  };
+  mutable Scratch BuildScratch;
+
 private:
   vtkVolumeCutProtection(const vtkVolumeCutProtection&) = delete;
   void operator=(const vtkVolumeCutProtection&) = delete;

@@ -14,6 +14,9 @@ Modules:
     benchmarks: the benchmark harness (one JSON per area).
     analyticscene: the mapper's accuracy scene (a cut cube) and its exact ray tracing and metrics.
     mapperbenchmarks: the ``mapper`` benchmark area (accuracy and frame times vs VTK's stock mapper).
+    slicebenchmarks: the ``sliceview`` benchmark area (cut overlay on slice views after a stroke).
+    workflowbenchmarks: the ``workflow`` benchmark area (first stroke, role change, shield memory,
+        live tables and reload on the patient-scale case, one core).
     toolconfig: cutting-tool parameters, presets, sensibility table and device choice, without Qt
         (shared by the desktop module and a web application).
     inputdevices: the mouse and the known haptic, 6-DoF and foot-switch devices plugged in

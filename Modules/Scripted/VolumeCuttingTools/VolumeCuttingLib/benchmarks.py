@@ -494,10 +494,17 @@ def sliceview(repeats: int) -> list[dict]:
     return slicebenchmarks.sliceview(repeats)
 
 
+def workflow(repeats: int) -> list[dict]:
+    from . import workflowbenchmarks
+
+    return workflowbenchmarks.workflow(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
+    "workflow": workflow,
     "sliceview": sliceview,
 }
 
