@@ -95,3 +95,4 @@ install(DIRECTORY Modules/Scripted/VolumeCuttingTools/VolumeCuttingLib DESTINATI
 # Data the library reads (VolumeCuttingLib.toolconfig finds it here, in
 # desktop Slicer's module resources and in the source tree).
 install(FILES Resources/Presets/VolumeCuttingToolPresets.json DESTINATION VolumeCuttingLib/Resources/Presets)
+install(FILES Resources/Sessions/HeadCTMastoidectomy.json DESTINATION VolumeCuttingLib/Resources/Sessions)

@@ -8,6 +8,8 @@ device) is VolumeCuttingLib.toolconfig; this file only shows it.
 """
 
 import logging
+import tempfile
+from pathlib import Path
 from typing import Annotated
 
 import qt
@@ -22,7 +24,7 @@ from slicer.ScriptedLoadableModule import (
 )
 from slicer.util import VTKObservationMixin
 
-from VolumeCuttingLib import headct, phantom, toolconfig
+from VolumeCuttingLib import headct, phantom, selftests, toolconfig
 
 # Read once: the parameter node's choices are fixed when the module loads.
 TOOL_PRESETS = {preset.name: preset for preset in toolconfig.load_presets()}
@@ -325,6 +327,9 @@ class VolumeCuttingToolsTest(ScriptedLoadableModuleTest):
         self.test_PhantomAndBoneSegmentation()
         self.setUp()
         self.test_ToolConfiguration()
+        for name in selftests.CASES:
+            self.setUp()
+            self.runSelfTestCase(name)
 
     def test_PhantomAndBoneSegmentation(self):
         self.delayDisplay("Generating a phantom")
@@ -354,3 +359,10 @@ class VolumeCuttingToolsTest(ScriptedLoadableModuleTest):
         self.assertEqual(tool.GetDiameter(), 3.0)
         self.assertEqual(logic.listDevices()[0].device_id, "mouse")
         self.delayDisplay("Test passed")
+
+    def runSelfTestCase(self, name):
+        """A case of VolumeCuttingLib.selftests, the same code pytest runs against slicer-core."""
+        with tempfile.TemporaryDirectory(prefix=f"volumecutting-{name}-") as folder:
+            context = selftests.SelfTestContext(slicer.mrmlScene, slicer.util.getModuleLogic("VolumeCutting"), Path(folder), self.delayDisplay)
+            selftests.CASES[name](context)
+        self.delayDisplay(f"{name}: passed")

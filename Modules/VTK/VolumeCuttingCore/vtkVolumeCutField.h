@@ -335,6 +335,11 @@ public:
    * a dense field of the same resolution would need.
    */
   vtkIdType GetNumberOfAllocatedBricks() const { return this->NumberOfAllocatedBricks.load(std::memory_order_acquire); }
+  /// The ID of the n-th allocated brick (in allocation order), -1 out of range.
+  vtkIdType GetAllocatedBrickId(vtkIdType n) const
+  {
+    return n >= 0 && n < this->GetNumberOfAllocatedBricks() ? this->AllocatedBrickIds[n].load(std::memory_order_relaxed) : -1;
+  }
   size_t GetBrickMemorySize() const;
   size_t GetDenseMemorySize() const;
   ///@}

@@ -19,7 +19,7 @@ import pytest
 import slicer
 import vtk
 
-from VolumeCuttingLib import nodes
+from VolumeCuttingLib import nodes, selftests
 from VolumeCuttingLib.application import HeadlessSlicer
 
 
@@ -88,37 +88,13 @@ def drilled_session(application, grid_name):
     return cut, ras
 
 
-def samples_by_position(field):
-    """Every stored sample that is not 'far outside', keyed by its RAS position (0.001 mm)."""
-    matrix = vtk.vtkMatrix4x4()
-    field.GetSubVoxelIJKToRAS(matrix)
-    sub_to_ras = nodes.vtk_matrix_to_numpy(matrix)
-    dims = field.GetBrickDimensions()
-    size = np.array(field.GetDimensions())
-    local = np.arange(512)
-    offsets = np.stack([local % 8, (local // 8) % 8, local // 64], axis=1)
-    values = np.zeros(512, dtype=np.int16)
-    out = {}
-    for brick in range(dims[0] * dims[1] * dims[2]):
-        if not field.CopyBrick(brick, values):
-            continue
-        origin = np.array([brick % dims[0], (brick // dims[0]) % dims[1], brick // (dims[0] * dims[1])]) * 8
-        index = origin + offsets
-        keep = (values != 32767) & np.all(index < size, axis=1)
-        ras = (sub_to_ras[:3, :3] @ index[keep].T).T + sub_to_ras[:3, 3]
-        for position, value in zip(np.round(ras, 3), values[keep]):
-            out[tuple(position)] = int(value)
-    return out
-
-
 def assert_same_cut(expected, actual):
     """The same samples at the same places, whatever the order of the grid's axes."""
     assert actual is not None
     assert sorted(actual.GetDimensions()) == sorted(expected.GetDimensions())
-    a = samples_by_position(expected)
-    b = samples_by_position(actual)
+    a = selftests.cut_samples_by_position(expected)
     assert len(a) > 1000
-    assert a == b
+    assert selftests.same_cut(expected, actual)
 
 
 class VtkMessages:

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import slicer
 
-from . import drilling, headct, owndata, phantom
+from . import drilling, headct, owndata, phantom, recording, selftests, toolconfig
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -139,6 +139,22 @@ def lateral_camera(view, segmentation_node, segment_ids):
     view.look_at(center, direction=(1.0, 0.0, 0.0), distance=2.2 * extent, view_up=(0.0, 0.0, 1.0))
 
 
+# The cutting burr matches the plan's; the last layers are polished with a 3 mm diamond burr.
+FINISHING_BURR_RADIUS = 1.5
+
+
+def session_tools(scene, plan) -> dict:
+    """Tool nodes from the shipped presets: a cutting burr of the plan's size and a 3 mm diamond burr."""
+    presets = {preset.name: preset for preset in toolconfig.load_presets()}
+    diameter = 2.0 * plan.burr_radius
+    cutting = presets.get(f"Cutting burr {diameter:g} mm")
+    cutting_parameters = toolconfig.from_preset(cutting) if cutting else toolconfig.from_preset(presets["Cutting burr 5 mm"], diameter=diameter)
+    return {
+        "cutting": toolconfig.create_tool_node(scene, cutting_parameters, cutting.name if cutting else f"Cutting burr {diameter:g} mm"),
+        "diamond": toolconfig.create_tool_node(scene, toolconfig.from_preset(presets["Diamond burr 3 mm"]), "Diamond burr 3 mm"),
+    }
+
+
 def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_data: OwnData | None = None) -> dict:
     """Run the job; ``own_data`` (the user's CT and segmentation) takes the place of the shipped data."""
     timer = Stopwatch()
@@ -194,8 +210,23 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         view.render()
     before_path = view.screenshot(out_dir / "cut_before.png")
 
+    # The surgeon's tools from the presets, and the drilling as a recorded
+    # session replayed through the tool nodes (the shipped recording on the
+    # head CT; elsewhere the plan, recorded on the fly). The removed volume
+    # per segment and the contacts are kept in tables as it goes.
+    tools = session_tools(application.scene, plan)
+    if use_phantom or own_data is not None:
+        session = recording.record_mastoidectomy(plan, finishing_radius=FINISHING_BURR_RADIUS)
+    else:
+        session = recording.load(recording.head_ct_mastoidectomy_path())
+    volume_table = logic.GetRemovedVolumeTableNode(cut_node)
     with timer.measure("drilling_s"):
-        drilled = drilling.drill(logic, cut_node, plan)
+        drilled = recording.replay(logic, cut_node, session, tools)
+    drilled["tool_presets"] = {key: tool.GetName() for key, tool in tools.items()}
+    contact_table = logic.GetContactTableNode(cut_node)
+    drilled["contact_events"] = contact_table.GetNumberOfRows()
+    drilled["removed_volume_table"] = {
+        volume_table.GetCellText(row, 0): float(volume_table.GetCellText(row, 3)) for row in range(volume_table.GetNumberOfRows())}
     removed_per_segment = {
         segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
         for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
@@ -243,8 +274,30 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     zoom_path = view.screenshot(out_dir / "cut_edge_zoom.png")
     renderer = view.renderer_description()
 
+    # A slice view across the cavity: the cut's outline and fill over the CT
+    # show how deep it goes (seed 000, Fig. 5d).
+    cavity = entry + 0.5 * plan.depth * np.asarray(plan.direction, dtype=float) / np.linalg.norm(plan.direction)
+    slice_view = application.create_slice_view("Axial", 600, 600, "Red")
+    slice_view.set_background_volume(volume)
+    # Slicer's axial orientation: the patient's right on the view's left.
+    slice_to_ras = np.diag([-1.0, 1.0, 1.0, 1.0])
+    slice_to_ras[:3, 3] = cavity
+    slice_view.set_slice_to_ras(slice_to_ras)
+    slice_view.slice_node.SetFieldOfView(70.0, 70.0, 1.0)
+    slice_path = slice_view.screenshot(out_dir / "cut_slice_axial.png")
+    slice_view.close()
+
     with timer.measure("save_scene_s"):
         bundle = application.save_bundle(out_dir / "scene.mrb")
+    # The saved session comes back whole: the same cut, sample for sample.
+    with timer.measure("reload_check_s"):
+        reloaded = HeadlessSlicer()
+        reloaded.load_bundle(bundle)
+        read = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
+        reload_check = {
+            "cut_identical": selftests.same_cut(read.GetCutField(), logic.GetCutField(cut_node)),
+            "removed_volume_mm3": round(reloaded.volume_cutting_logic.GetRemovedVolume(read), 2),
+        }
 
     segmentation = bone.GetSegmentation()
     summary = {
@@ -285,6 +338,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         "image_before_cutting": str(before_path),
         "image_cut_edge_zoom": str(zoom_path),
         "scene_bundle": str(bundle),
+        "reload_check": reload_check,
+        "image_slice_view": str(slice_path),
         "timings": timer.seconds,
     }
     if own_data is not None:

@@ -27,6 +27,7 @@ from pathlib import Path
 import slicer
 
 from .inputdevices import InputDevice, list_devices  # noqa: F401  (part of this module's interface)
+from .resources import find_resource
 
 PRESETS_FILE_NAME = "VolumeCuttingToolPresets.json"
 PRESETS_FORMAT = "VolumeCuttingToolPresets"
@@ -167,23 +168,14 @@ def from_preset(preset: ToolPreset, **overrides) -> ToolParameters:
 
 
 def default_presets_path() -> Path:
-    """The shipped presets file, wherever this library is installed.
+    """The shipped presets file, wherever this library is installed (see resources.find_resource).
 
-    Looked for in the wheel (inside VolumeCuttingLib), in desktop Slicer (the
-    scripted module's Resources beside VolumeCuttingLib) and in the source
-    tree (top-level Resources). Raises PresetError naming the places tried.
+    Raises PresetError naming the places tried.
     """
-    library = Path(__file__).resolve().parent
-    candidates = [
-        library / "Resources" / "Presets" / PRESETS_FILE_NAME,
-        library.parent / "Resources" / "Presets" / PRESETS_FILE_NAME,
-        library.parents[3] / "Resources" / "Presets" / PRESETS_FILE_NAME if len(library.parents) > 3 else None,
-    ]
-    for candidate in candidates:
-        if candidate is not None and candidate.is_file():
-            return candidate
-    tried = ", ".join(str(c) for c in candidates if c is not None)
-    raise PresetError(f"The tool presets file {PRESETS_FILE_NAME} was not found (looked in {tried}); reinstall VolumeCutting")
+    try:
+        return find_resource("Presets", PRESETS_FILE_NAME)
+    except FileNotFoundError as error:
+        raise PresetError(f"The tool presets file: {error}") from None
 
 
 def load_presets(path: str | Path | None = None) -> list[ToolPreset]:
