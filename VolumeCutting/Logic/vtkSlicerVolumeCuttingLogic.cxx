@@ -1020,6 +1020,12 @@ bool vtkSlicerVolumeCuttingLogic::MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, 
   }
   vtkVolumeCutField* field = cutNode->GetCutField();
   bool accepted = true;
+  if (action == ToolMove && field && !field->IsStrokeOpen() && this->GetCutField(cutNode) == field)
+  {
+    // Hovering: the shield around the tool is built now, before it cuts there.
+    const double center[3] = { toolToRAS->GetElement(0, 3), toolToRAS->GetElement(1, 3), toolToRAS->GetElement(2, 3) };
+    field->PrepareProtection(center, toolNode->GetBoundingRadius() + 2.0);
+  }
   if (action != ToolMove && field && field->IsStrokeOpen())
   {
     // The first pose of a stroke cuts where it is; the next ones sweep from the last.

@@ -318,6 +318,60 @@ const vtkVolumeCutProtection::Brick* vtkVolumeCutField::GetProtectionBrick(vtkId
 }
 
 //------------------------------------------------------------------------------
+vtkIdType vtkVolumeCutField::PrepareProtection(const double center[3], double radius)
+{
+  if (!this->Directory || !center || !IsFinite(center) || !(radius >= 0.0) || !this->Protection->HasShieldedLabels())
+  {
+    return 0;
+  }
+  const vtkIdType before = this->Protection->GetNumberOfBuiltBricks();
+  const double reach = radius + this->BandWidth;
+  // The bricks of the sub-voxel box around the ball, then those the ball meets.
+  int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
+  int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    double ras[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      ras[axis] = center[axis] + ((corner >> axis) & 1 ? reach : -reach);
+    }
+    double index[3];
+    Transform(this->RASToSubIJK, ras, index);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double clamped = std::max(-1.0, std::min(static_cast<double>(this->Dimensions[axis]), index[axis]));
+      lower[axis] = std::min(lower[axis], static_cast<int>(std::floor(clamped)));
+      upper[axis] = std::max(upper[axis], static_cast<int>(std::ceil(clamped)));
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    lower[axis] = std::max(lower[axis], 0) / BrickSize;
+    upper[axis] = std::min(upper[axis], this->Dimensions[axis] - 1) / BrickSize;
+  }
+  const double limit = reach + this->BrickBoundingRadius;
+  for (int bk = lower[2]; bk <= upper[2]; ++bk)
+  {
+    for (int bj = lower[1]; bj <= upper[1]; ++bj)
+    {
+      for (int bi = lower[0]; bi <= upper[0]; ++bi)
+      {
+        const double middle = 0.5 * (BrickSize - 1);
+        const double centerSample[3] = { bi * BrickSize + middle, bj * BrickSize + middle, bk * BrickSize + middle };
+        double brickCenter[3];
+        Transform(this->SubIJKToRAS, centerSample, brickCenter);
+        if (vtkMath::Distance2BetweenPoints(brickCenter, center) <= limit * limit)
+        {
+          this->GetProtectionBrick((static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi);
+        }
+      }
+    }
+  }
+  return this->Protection->GetNumberOfBuiltBricks() - before;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutField::SetProtectedLabels(vtkImageData* labels)
 {
   if (labels)

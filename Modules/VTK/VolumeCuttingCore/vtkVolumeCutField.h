@@ -202,6 +202,14 @@ public:
   vtkVolumeCutProtection* GetProtection() { return this->Protection; }
 
   /**
+   * Build the shield where a tool at center (RAS) with the given reach (mm)
+   * could cut next, so that its first strokes there find it built: call it
+   * while the tool hovers, from the writer's thread. Returns the number of
+   * bricks built.
+   */
+  vtkIdType PrepareProtection(const double center[3], double radius);
+
+  /**
    * Shield structures given as one label image with the anatomy's dimensions
    * (IJK geometry; one integer component): 0 for voxels a tool may cut, k > 0
    * for the k-th protected structure (labels above 255 are reported as 255).

@@ -168,6 +168,13 @@ def test_tables_and_contact_events():
     assert [table.GetCellText(r, 2) for r in range(3)] == ["cuttable", "cuttable", "protected"]
     assert all(float(table.GetCellText(r, 3)) == 0.0 for r in range(3))
 
+    # Hovering near the nerve builds its shield before the burr cuts there.
+    protection = logic.GetCutField(cut).GetProtection()
+    built = protection.GetNumberOfBuiltBricks()
+    assert logic.MoveActiveTool(cut, pose(ras(12, 24, 15)), logic.ToolMove)
+    assert protection.GetNumberOfShieldBricks() > 0 and protection.GetNumberOfBuiltBricks() > built
+    assert logic.GetRemovedVolume(cut) == 0.0
+
     events = []
     observer = cut.AddObserver(slicer.vtkMRMLVolumeCutNode.ProtectedContactEvent, lambda caller, event: events.append(logic.GetCutField(cut).GetMaximumContactDepth()))
     # Along the nerve's canal, into it: the nerve stops the burr.

@@ -255,3 +255,42 @@ def test_grid_change_resamples_or_refuses(tmp_path):
     cut.SetAndObserveAnatomyVolumeNodeID(volume.GetID())
     assert logic.GetRemovedVolume(cut) == pytest.approx(resampled, rel=1e-12)
     assert logic.GetCutField(cut) is field
+
+
+def test_mutated_cut_files_never_load_as_another_cut(tmp_path):
+    """150 mutations of a real session's .vcut (byte flips, truncations, header overwrites, appended bytes):
+    each is refused with a message naming the file, and the field read into keeps its cut."""
+    application = HeadlessSlicer()
+    cut, _ = drilled_session(application, "head_ct")
+    field = cut.GetCutField()
+    path = tmp_path / "session.vcut"
+    assert field.WriteFile(str(path))
+    original = path.read_bytes()
+    rng = np.random.default_rng(150)
+    target = slicer.vtkVolumeCutField()
+    assert target.ReadFile(str(path))
+    refused = 0
+    for n in range(150):
+        data = bytearray(original)
+        kind = n % 4
+        if kind == 0:
+            position = int(rng.integers(0, len(data)))
+            data[position] ^= int(rng.integers(1, 256))
+        elif kind == 1:
+            data = data[: int(rng.integers(0, len(data)))]
+        elif kind == 2:
+            start = int(rng.integers(0, 160))
+            data[start : start + 8] = bytes(int(rng.integers(0, 256)) for _ in range(8))
+            if bytes(data) == original:
+                continue
+        else:
+            data += bytes(int(rng.integers(1, 64)))
+        damaged = tmp_path / "damaged.vcut"
+        damaged.write_bytes(bytes(data))
+        with VtkMessages() as messages:
+            loaded = target.ReadFile(str(damaged))
+        refused += not loaded
+        assert not loaded, f"mutation {n} loaded"
+        assert "damaged.vcut" in messages.text
+        assert selftests.same_cut(field, target)
+    assert refused > 140
