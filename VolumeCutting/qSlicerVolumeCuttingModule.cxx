@@ -90,6 +90,7 @@ void qSlicerVolumeCuttingModule::setup()
   this->Superclass::setup();
   // 3D views show volume-cut nodes through the adaptive multivolume mapper.
   vtkMRMLThreeDViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutDisplayableManager");
+  vtkMRMLThreeDViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutToolDisplayableManager");
   // Slice views outline and fill the cut region where they cut it.
   vtkMRMLSliceViewDisplayableManagerFactory::GetInstance()->RegisterDisplayableManager("vtkMRMLVolumeCutSliceDisplayableManager");
 }

@@ -155,6 +155,8 @@ class ThreeDView:
         # it is added to the view's group directly.
         self.volume_cut_displayable_manager = slicer.vtkMRMLVolumeCutDisplayableManager()
         self.displayable_managers.AddDisplayableManager(self.volume_cut_displayable_manager)
+        self.tool_displayable_manager = slicer.vtkMRMLVolumeCutToolDisplayableManager()
+        self.displayable_managers.AddDisplayableManager(self.tool_displayable_manager)
         self.displayable_managers.SetMRMLDisplayableNode(self.view_node)
 
     def look_at(self, focal_point, direction, distance, view_up=(0.0, 0.0, 1.0)):
