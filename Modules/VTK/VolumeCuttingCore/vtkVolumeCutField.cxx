@@ -1283,8 +1283,8 @@ void vtkVolumeCutField::ForEachSampleOfBrickWithShield(vtkIdType brickId, Visito
   const int f = std::max(this->SubVoxelFactor, 1);
   const int anatomyPerBrick = BrickSize / f; // bricks hold whole anatomy voxels
   uint8_t shield[BrickSize * BrickSize * BrickSize];
-  const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
-    static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+  int b[3];
+  this->GetBrickIndex(brickId, b);
   const int voxelLower[3] = { b[0] * anatomyPerBrick, b[1] * anatomyPerBrick, b[2] * anatomyPerBrick };
   const int voxelUpper[3] = { voxelLower[0] + anatomyPerBrick - 1, voxelLower[1] + anatomyPerBrick - 1, voxelLower[2] + anatomyPerBrick - 1 };
   this->Protection->GetShieldLabels(voxelLower, voxelUpper, shield);
@@ -1385,8 +1385,8 @@ void vtkVolumeCutField::AppendRemovedVoxelsOfBrick(vtkIdType brickId, vtkIdTypeA
   const int f = std::max(this->SubVoxelFactor, 1);
   const int anatomyPerBrick = BrickSize / f;
   const int dims[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
-  const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
-    static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+  int b[3];
+  this->GetBrickIndex(brickId, b);
   double sums[BrickSize * BrickSize * BrickSize] = {};
   this->ForEachSampleOfBrickWithShield(brickId, [&](int i, int j, int k, bool shielded) {
     if (shielded && this->ReadSample(i, j, k) >= 0)
@@ -1510,8 +1510,8 @@ void vtkVolumeCutField::ExtractRemovedSurface(vtkPolyData* surface) const
   for (vtkIdType n = 0; n < count; ++n)
   {
     const vtkIdType brickId = this->AllocatedBrickIds[n].load(std::memory_order_relaxed);
-    const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
-      static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+    int b[3];
+    this->GetBrickIndex(brickId, b);
     for (int axis = 0; axis < 3; ++axis)
     {
       lower[axis] = std::min(lower[axis], b[axis] * BrickSize - 1);
@@ -1563,6 +1563,26 @@ bool vtkVolumeCutField::ReadFile(const char* fileName)
   vtkNew<vtkVolumeCutFieldFile> file;
   file->SetFileName(fileName);
   return file->Read(this);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::GetBrickIndex(vtkIdType brickId, int index[3]) const
+{
+  index[0] = static_cast<int>(brickId % this->BrickDimensions[0]);
+  index[1] = static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]);
+  index[2] = static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1]));
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutField::ReplaceBricks(const BrickStates& bricks)
+{
+  // A field made from another has its own history, starting now.
+  this->EndStroke();
+  this->UndoStack.clear();
+  this->RedoStack.clear();
+  this->UndoMemorySize = 0;
+  this->LastCapsule.Valid = false;
+  this->WriteBricks(bricks);
 }
 
 //------------------------------------------------------------------------------
@@ -1626,9 +1646,8 @@ bool vtkVolumeCutField::CopyFromSameLattice(vtkVolumeCutField* source)
   {
     const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
     source->CopyBrick(brickId, values);
-    const int b[3] = { static_cast<int>(brickId % source->BrickDimensions[0]),
-      static_cast<int>((brickId / source->BrickDimensions[0]) % source->BrickDimensions[1]),
-      static_cast<int>(brickId / (static_cast<vtkIdType>(source->BrickDimensions[0]) * source->BrickDimensions[1])) };
+    int b[3];
+    source->GetBrickIndex(brickId, b);
     for (int local = 0; local < SamplesPerBrick; ++local)
     {
       if (values[local] == Outside)
@@ -1667,12 +1686,7 @@ bool vtkVolumeCutField::CopyFromSameLattice(vtkVolumeCutField* source)
       targetValues[((target[2] % BrickSize) * BrickSize + target[1] % BrickSize) * BrickSize + target[0] % BrickSize] = values[local];
     }
   }
-  this->EndStroke();
-  this->UndoStack.clear();
-  this->RedoStack.clear();
-  this->UndoMemorySize = 0;
-  this->LastCapsule.Valid = false;
-  this->WriteBricks(bricks);
+  this->ReplaceBricks(bricks);
   return true;
 }
 
@@ -1695,9 +1709,8 @@ bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
   for (vtkIdType n = 0; n < sourceCount; ++n)
   {
     const vtkIdType brickId = source->AllocatedBrickIds[n].load(std::memory_order_relaxed);
-    const int b[3] = { static_cast<int>(brickId % source->BrickDimensions[0]),
-      static_cast<int>((brickId / source->BrickDimensions[0]) % source->BrickDimensions[1]),
-      static_cast<int>(brickId / (static_cast<vtkIdType>(source->BrickDimensions[0]) * source->BrickDimensions[1])) };
+    int b[3];
+    source->GetBrickIndex(brickId, b);
     int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
     int upper[3] = { std::numeric_limits<int>::min(), std::numeric_limits<int>::min(), std::numeric_limits<int>::min() };
     for (int corner = 0; corner < 8; ++corner)
@@ -1745,8 +1758,8 @@ bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
   const double inverseQuantum = 1.0 / this->Quantum;
   for (vtkIdType brickId : targets)
   {
-    const int b[3] = { static_cast<int>(brickId % this->BrickDimensions[0]), static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
-      static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+    int b[3];
+    this->GetBrickIndex(brickId, b);
     BrickValues values(SamplesPerBrick, Outside);
     bool any = false;
     for (int local = 0; local < SamplesPerBrick; ++local)
@@ -1768,12 +1781,7 @@ bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
       bricks[brickId] = std::move(values);
     }
   }
-  this->EndStroke();
-  this->UndoStack.clear();
-  this->RedoStack.clear();
-  this->UndoMemorySize = 0;
-  this->LastCapsule.Valid = false;
-  this->WriteBricks(bricks);
+  this->ReplaceBricks(bricks);
   return true;
 }
 

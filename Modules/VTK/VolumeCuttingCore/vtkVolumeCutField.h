@@ -431,6 +431,10 @@ protected:
   void RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick);
   void PushUndoStep(UndoStep&& step);
   void WriteBricks(const BrickStates& bricks);
+  /// Write bricks as the whole new content of a field made from another (no history).
+  void ReplaceBricks(const BrickStates& bricks);
+  /// The brick's (i, j, k) in the brick grid.
+  void GetBrickIndex(vtkIdType brickId, int index[3]) const;
   int16_t ReadSample(int i, int j, int k) const;
   double InterpolateAtIndex(const double index[3]) const;
   /// The interpolation of InterpolateAtIndex over samples given by read(i, j, k).
