@@ -1020,7 +1020,7 @@ bool vtkSlicerVolumeCuttingLogic::MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, 
   }
   vtkVolumeCutField* field = cutNode->GetCutField();
   bool accepted = true;
-  if (action == ToolMove && field && !field->IsStrokeOpen() && this->GetCutField(cutNode) == field)
+  if (action == ToolMove && !(field && field->IsStrokeOpen()) && (field = this->GetCutField(cutNode)) != nullptr)
   {
     // Hovering: the shield around the tool is built now, before it cuts there.
     const double center[3] = { toolToRAS->GetElement(0, 3), toolToRAS->GetElement(1, 3), toolToRAS->GetElement(2, 3) };
