@@ -6,6 +6,7 @@
 #include "vtkVolumeCutKernels.h"
 #include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutProtectionBrick.h"
+#include "vtkVolumeCutSampledRegionSource.h"
 #include "vtkVolumeCutSweepSources.h"
 
 #include "vtkDataArray.h"
@@ -509,6 +510,81 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
   std::vector<vtkVolumeCutSweeps::RigidPose> poses = vtkVolumeCutSweeps::InterpolatePoses(start, end, tool->GetBoundingRadius(), step);
   const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
   this->ApplyDistance(source, operation);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* keep)
+{
+  if (!this->Directory)
+  {
+    vtkErrorMacro("CutSampledRegion: the cut field is not initialized");
+    return false;
+  }
+  vtkDataArray* values = distances ? distances->GetPointData()->GetScalars() : nullptr;
+  if (!values || (values->GetDataType() != VTK_FLOAT && values->GetDataType() != VTK_DOUBLE) || values->GetNumberOfTuples() == 0)
+  {
+    vtkErrorMacro("CutSampledRegion: the distances need float or double scalars; nothing was cut");
+    return false;
+  }
+  vtkDataArray* keepValues = keep ? keep->GetPointData()->GetScalars() : nullptr;
+  if (keep && (!keepValues || !keepValues->IsIntegral() || keepValues->GetNumberOfComponents() != 1))
+  {
+    vtkErrorMacro("CutSampledRegion: the voxels to keep need one integer scalar component; nothing was cut");
+    return false;
+  }
+  const int components = values->GetNumberOfComponents();
+  std::vector<float> converted;
+  const float* samples = nullptr;
+  if (values->GetDataType() == VTK_FLOAT)
+  {
+    samples = static_cast<const float*>(values->GetVoidPointer(0));
+  }
+  else
+  {
+    converted.resize(static_cast<size_t>(values->GetNumberOfValues()));
+    const double* source = static_cast<const double*>(values->GetVoidPointer(0));
+    std::transform(source, source + converted.size(), converted.begin(), [](double v) { return static_cast<float>(v); });
+    samples = converted.data();
+  }
+  const int f = this->SubVoxelFactor;
+  double spacing[3];
+  this->GetSubVoxelSpacing(spacing);
+  vtkSmartPointer<vtkVolumeCutProtection> keepOut;
+  if (keep)
+  {
+    // The keep-out set is a shield of its own, built where the region reaches.
+    const int anatomyDimensions[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
+    const double anatomySpacing[3] = { spacing[0] * f, spacing[1] * f, spacing[2] * f };
+    keepOut = vtkSmartPointer<vtkVolumeCutProtection>::New();
+    keepOut->SetFieldGeometry(anatomyDimensions, f, anatomySpacing, this->BandWidth, this->Quantum);
+    const int image = keepOut->AddLabelImage(keep);
+    double range[2];
+    keepValues->GetRange(range, 0);
+    const int largest = static_cast<int>(std::min<double>(range[1], vtkVolumeCutProtection::MaximumLabelValue));
+    for (int value = 1; value <= largest; ++value)
+    {
+      keepOut->SetShieldLabel(image, value, 1);
+    }
+  }
+  vtkNew<vtkMatrix4x4> ijkToRAS;
+  ijkToRAS->DeepCopy(this->AnatomyIJKToRAS);
+  vtkNew<vtkMatrix4x4> rasToIJK;
+  vtkMatrix4x4::Invert(ijkToRAS, rasToIJK);
+  double ijkToRASRows[4][4];
+  double rasToIJKRows[4][4];
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      ijkToRASRows[row][column] = ijkToRAS->GetElement(row, column);
+      rasToIJKRows[row][column] = rasToIJK->GetElement(row, column);
+    }
+  }
+  const vtkVolumeCutSweeps::SampledRegionSource source(samples, components, distances->GetExtent(), rasToIJKRows, ijkToRASRows, this->BandWidth,
+    keepOut, this->RASToSubIJK, this->BrickDimensions, this->Quantum, 0.5 * std::max({ spacing[0], spacing[1], spacing[2] }));
+  this->ApplyDistance(source, Operation::Cut);
+  this->LastCapsule.Valid = false;
   return true;
 }
 
