@@ -147,10 +147,9 @@ struct PlanData
   vtkIdType Count = 0;
   std::vector<float> Values;
   std::vector<uint8_t> Class;
-  std::vector<int> FeatureIn;
-  std::vector<int> FeatureOut;
-  std::unordered_map<int, int> SegmentIn;
-  std::unordered_map<int, int> SegmentOut;
+  /// Each voxel's nearest strip site, and each site's outline segment.
+  std::vector<int> Feature;
+  std::unordered_map<int, int> StripSites;
   std::vector<float> Wall; // NaN until needed
   std::vector<float> Depth;
   vtkIdType FilledCount = 0;
@@ -176,6 +175,12 @@ struct vtkVolumeCutResectionPlanner::Internals
 
   std::unique_ptr<PlanData> Current;
   std::unique_ptr<PlanData> Next;
+  /// Working arrays of the transforms, kept between plans (a new plan of
+  /// the same size then touches no fresh memory).
+  std::vector<unsigned char> Sites;
+  std::vector<float> Work;
+  std::vector<int> Scratch;
+  std::vector<int> Nearest;
   /// Voxels added to each face of the box by growth, for the inputs of GrowthTime.
   int Growth[6] = { 0, 0, 0, 0, 0, 0 };
   vtkMTimeType GrowthTime = 0;
@@ -209,13 +214,64 @@ struct vtkVolumeCutResectionPlanner::Internals
     return ras;
   }
 
+  /// A float copy of the anatomy around the outline, where the outline is
+  /// put on the skin and its normals are taken (reading the image's array
+  /// through its virtual accessor there would cost more than the shape).
+  int LocalBox[6] = { 0, -1, 0, -1, 0, -1 };
+  std::vector<float> Local;
+
   /// CT value of anatomy voxel (i, j, k), clamped to the volume.
   double Voxel(int i, int j, int k) const
   {
     i = std::max(0, std::min(this->Dims[0] - 1, i));
     j = std::max(0, std::min(this->Dims[1] - 1, j));
     k = std::max(0, std::min(this->Dims[2] - 1, k));
+    if (i >= this->LocalBox[0] && i <= this->LocalBox[1] && j >= this->LocalBox[2] && j <= this->LocalBox[3] && k >= this->LocalBox[4] &&
+      k <= this->LocalBox[5])
+    {
+      const int sx = this->LocalBox[1] - this->LocalBox[0] + 1;
+      const int sy = this->LocalBox[3] - this->LocalBox[2] + 1;
+      return this->Local[(static_cast<size_t>(k - this->LocalBox[4]) * sy + (j - this->LocalBox[2])) * sx + (i - this->LocalBox[0])];
+    }
     return this->Scalars->GetComponent((static_cast<vtkIdType>(k) * this->Dims[1] + j) * this->Dims[0] + i, 0);
+  }
+
+  /// Copies the anatomy's voxels in box (clipped to the volume) into floats: out has the box's size.
+  bool CopyVoxels(int box[6], std::vector<float>& out) const
+  {
+    for (int a = 0; a < 3; ++a)
+    {
+      box[2 * a] = std::max(0, box[2 * a]);
+      box[2 * a + 1] = std::min(this->Dims[a] - 1, box[2 * a + 1]);
+      if (box[2 * a + 1] < box[2 * a])
+      {
+        out.clear();
+        return true;
+      }
+    }
+    out.resize(static_cast<size_t>(box[1] - box[0] + 1) * (box[3] - box[2] + 1) * (box[5] - box[4] + 1));
+    if (this->Scalars->GetNumberOfComponents() == 1)
+    {
+      switch (this->Scalars->GetDataType())
+      {
+        vtkTemplateMacro(CopyBox(static_cast<const VTK_TT*>(this->Scalars->GetVoidPointer(0)), this->Dims, box, out.data()));
+        default:
+          return false;
+      }
+      return true;
+    }
+    size_t index = 0;
+    for (int k = box[4]; k <= box[5]; ++k)
+    {
+      for (int j = box[2]; j <= box[3]; ++j)
+      {
+        for (int i = box[0]; i <= box[1]; ++i)
+        {
+          out[index++] = static_cast<float>(this->Scalars->GetComponent((static_cast<vtkIdType>(k) * this->Dims[1] + j) * this->Dims[0] + i, 0));
+        }
+      }
+    }
+    return true;
   }
 
   /// Trilinear CT value at a grid-frame point, from the whole anatomy.
@@ -258,12 +314,15 @@ struct vtkVolumeCutResectionPlanner::Internals
   }
 
   /**
-   * The gradient averaged over the (2r+1)^3 voxel-spaced points around x:
-   * the sum of their central differences telescopes to the layers r and
-   * r + 1 voxels away on either side.
+   * The gradient averaged over the (2r+1)^3 points around x spaced the
+   * largest voxel spacing apart along every axis (a cube in mm, so that a
+   * curved surface's normal is not tilted towards the finer axes): the sum of
+   * their central differences telescopes to the layers r and r + 1 steps away
+   * on either side.
    */
   Vec BoxGradient(const Vec& x, int r) const
   {
+    const double h = this->MaxSpacing();
     Vec g{ 0.0, 0.0, 0.0 };
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -275,19 +334,19 @@ struct vtkVolumeCutResectionPlanner::Internals
         for (int oc = -r; oc <= r; ++oc)
         {
           Vec y = x;
-          y[b] += ob * this->Spacing[b];
-          y[c] += oc * this->Spacing[c];
+          y[b] += ob * h;
+          y[c] += oc * h;
           for (int layer : { r, r + 1 })
           {
             Vec up = y;
             Vec down = y;
-            up[axis] += layer * this->Spacing[axis];
-            down[axis] -= layer * this->Spacing[axis];
+            up[axis] += layer * h;
+            down[axis] -= layer * h;
             sum += this->Sample(up) - this->Sample(down);
           }
         }
       }
-      g[axis] = sum / this->Spacing[axis];
+      g[axis] = sum;
     }
     return g;
   }
@@ -503,21 +562,21 @@ bool vtkVolumeCutResectionPlanner::Plan()
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumeCutResectionPlanner::BuildShape()
+bool vtkVolumeCutResectionPlanner::UpdateGrid(const char* caller)
 {
   Internals& impl = *this->Impl;
-  this->ErrorMessage.clear();
+  const std::string where = std::string(caller) + ": ";
   vtkDataArray* scalars = this->Anatomy ? this->Anatomy->GetPointData()->GetScalars() : nullptr;
   if (!this->Anatomy || !this->IJKToRAS || !scalars)
   {
-    return this->Fail("BuildShape: no CT with scalars; give the planner the CT with SetAnatomy");
+    return this->Fail(where + "no CT with scalars; give the planner the CT with SetAnatomy");
   }
   int dims[3];
   this->Anatomy->GetDimensions(dims);
   const int* extent = this->Anatomy->GetExtent();
   if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2 || extent[0] != 0 || extent[2] != 0 || extent[4] != 0)
   {
-    return this->Fail("BuildShape: the CT must have at least 2 voxels along each axis and an extent starting at 0");
+    return this->Fail(where + "the CT must have at least 2 voxels along each axis and an extent starting at 0");
   }
   double spacing[3];
   double axes[3][3];
@@ -531,7 +590,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
     spacing[column] = Norm(axis);
     if (!(spacing[column] > 0.0) || !std::isfinite(spacing[column]))
     {
-      return this->Fail("BuildShape: the CT's IJK-to-RAS matrix has a zero or non-finite spacing");
+      return this->Fail(where + "the CT's IJK-to-RAS matrix has a zero or non-finite spacing");
     }
     for (int row = 0; row < 3; ++row)
     {
@@ -544,7 +603,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
     {
       if (std::abs(axes[0][a] * axes[0][b] + axes[1][a] * axes[1][b] + axes[2][a] * axes[2][b]) > 1e-3)
       {
-        return this->Fail("BuildShape: the CT's voxel axes are not orthogonal (a sheared grid); resample it onto an orthogonal grid first");
+        return this->Fail(where + "the CT's voxel axes are not orthogonal (a sheared grid); resample it onto an orthogonal grid first");
       }
     }
   }
@@ -555,7 +614,40 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
     std::copy(axes[row], axes[row] + 3, impl.Axes[row]);
     impl.Origin[row] = this->IJKToRAS->GetElement(row, 3);
   }
+  // The local copy is made again for each outline (the CT may have changed).
+  impl.LocalBox[0] = impl.LocalBox[2] = impl.LocalBox[4] = 0;
+  impl.LocalBox[1] = impl.LocalBox[3] = impl.LocalBox[5] = -1;
   impl.Scalars = scalars;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutResectionPlanner::GetDistanceToSkin(const double ras[3], double reach)
+{
+  if (!ras || !this->UpdateGrid("GetDistanceToSkin"))
+  {
+    return VTK_DOUBLE_MAX;
+  }
+  const Vec x = this->Impl->FromRAS({ ras[0], ras[1], ras[2] });
+  Vec onSkin;
+  if (!this->Impl->ToSkin(x, reach, this->SkinIsoValue, onSkin))
+  {
+    return VTK_DOUBLE_MAX;
+  }
+  return Norm(Sub(onSkin, x));
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutResectionPlanner::BuildShape()
+{
+  Internals& impl = *this->Impl;
+  this->ErrorMessage.clear();
+  if (!this->UpdateGrid("BuildShape"))
+  {
+    return false;
+  }
+  const int* dims = impl.Dims;
+  const double* spacing = impl.Spacing;
   if (this->GetMTime() != impl.GrowthTime)
   {
     std::fill(impl.Growth, impl.Growth + 6, 0);
@@ -604,6 +696,37 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
       " distinct point(s); a closed outline on the skin needs at least 3");
   }
   const double iso = this->SkinIsoValue;
+  {
+    // Everything the outline's points and normals read: the points' box
+    // grown by the search reach and the normals' stencil.
+    double lowest[3] = { std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity() };
+    double highest[3] = { -lowest[0], -lowest[1], -lowest[2] };
+    for (const Vec& x : given)
+    {
+      for (int a = 0; a < 3; ++a)
+      {
+        lowest[a] = std::min(lowest[a], x[a] / spacing[a]);
+        highest[a] = std::max(highest[a], x[a] / spacing[a]);
+      }
+    }
+    const double searchReach = std::max(this->SkinTolerance, 3.0 * std::max({ spacing[0], spacing[1], spacing[2] }));
+    impl.LocalBox[0] = impl.LocalBox[2] = impl.LocalBox[4] = 0;
+    impl.LocalBox[1] = impl.LocalBox[3] = impl.LocalBox[5] = -1;
+    int local[6];
+    for (int a = 0; a < 3; ++a)
+    {
+      const int pad = 2 + static_cast<int>(std::ceil((searchReach + 3.0 * std::max({ spacing[0], spacing[1], spacing[2] })) / spacing[a]));
+      local[2 * a] = static_cast<int>(std::floor(lowest[a])) - pad;
+      local[2 * a + 1] = static_cast<int>(std::ceil(highest[a])) + pad;
+    }
+    std::vector<float> values;
+    if (!impl.CopyVoxels(local, values))
+    {
+      return this->Fail("BuildShape: the CT's scalar type is not supported");
+    }
+    impl.Local.swap(values);
+    std::copy(local, local + 6, impl.LocalBox);
+  }
   for (size_t k = 0; k < given.size(); ++k)
   {
     const Vec ras = impl.ToRAS(given[k]);
@@ -825,37 +948,23 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
   PlanData& p = *plan;
   p.Count = static_cast<vtkIdType>(voxels);
   const vtkIdType N = p.Count;
-  p.Values.resize(N);
-  if (scalars->GetNumberOfComponents() == 1)
   {
-    switch (scalars->GetDataType())
-    {
-      vtkTemplateMacro(CopyBox(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), dims, p.Box, p.Values.data()));
-      default:
-        return this->Fail("BuildShape: the CT's scalar type is not supported");
-    }
-  }
-  else
-  {
-    for (int c = 0; c < p.Size[2]; ++c)
-    {
-      for (int b = 0; b < p.Size[1]; ++b)
-      {
-        for (int a = 0; a < p.Size[0]; ++a)
-        {
-          p.Values[p.Index(a, b, c)] = static_cast<float>(impl.Voxel(p.Box[0] + a, p.Box[2] + b, p.Box[4] + c));
-        }
-      }
-    }
+    int box[6];
+    std::copy(p.Box, p.Box + 6, box);
+    impl.CopyVoxels(box, p.Values);
   }
 
-  // Two exact distance transforms, towards the inner and the outer strip.
-  std::vector<unsigned char> sites(N, 0);
-  std::vector<float> inner(N);
-  std::vector<float> outer(N);
-  auto rasterize = [&](const std::vector<Vec>& strip, std::unordered_map<int, int>& segments) {
-    std::fill(sites.begin(), sites.end(), 0);
-    segments.clear();
+  // One exact distance transform towards both strips: a voxel is in the
+  // shape when its nearest strip site lies on the inner strip (the paper's
+  // two transforms and their comparison, in one pass).
+  std::vector<unsigned char>& sites = impl.Sites;
+  sites.assign(N, 0);
+  std::vector<int>& onStrip = impl.Scratch; // read only at sites: 1 inner, 2 outer
+  onStrip.resize(N);
+  p.StripSites.clear();
+  for (int which = 1; which <= 2; ++which)
+  {
+    const std::vector<Vec>& strip = which == 1 ? p.Inner : p.Outer;
     for (int k = 0; k < n; ++k)
     {
       const Vec& a = strip[k];
@@ -877,27 +986,24 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
           if (!sites[id])
           {
             sites[id] = 1;
-            segments.emplace(static_cast<int>(id), k);
+            onStrip[id] = which;
+            p.StripSites.emplace(static_cast<int>(id), k);
           }
         }
       }
     }
-  };
-  p.FeatureIn.resize(N);
-  p.FeatureOut.resize(N);
-  rasterize(p.Inner, p.SegmentIn);
-  vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), inner.data(), p.FeatureIn.data());
-  rasterize(p.Outer, p.SegmentOut);
-  vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), outer.data(), p.FeatureOut.data());
+  }
+  p.Feature.resize(N);
+  impl.Work.resize(N);
+  vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), impl.Work.data(), p.Feature.data());
   p.Class.resize(N);
   vtkSMPTools::For(0, N, [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType id = begin; id < end; ++id)
     {
-      p.Class[id] = inner[id] < outer[id] ? vtkVolumeCutResectionPlanner::InShape : 0;
+      const int site = p.Feature[id];
+      p.Class[id] = site >= 0 && onStrip[site] == 1 ? vtkVolumeCutResectionPlanner::InShape : 0;
     }
   });
-  std::vector<float>().swap(inner);
-  std::vector<float>().swap(outer);
 
   // The skin inside the outline: tissue voxels next to air, connected
   // (26-neighbours) to the skin just inside the outline.
@@ -1072,7 +1178,8 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
   // The skin's sub-voxel surface near each of its voxels inside the outline:
   // where the CT crosses the iso-value along the gradient, and the inward
   // normal there.
-  std::vector<int> slot(N, -1);
+  std::vector<int>& slot = impl.Scratch;
+  slot.resize(N);
   std::vector<vtkIdType> skin;
   for (vtkIdType id = 0; id < N; ++id)
   {
@@ -1140,16 +1247,16 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
 
   // The third transform: every voxel's nearest skin voxel, then its depth
   // under that voxel's tangent plane.
-  std::vector<unsigned char> sites(N);
+  std::vector<unsigned char>& sites = impl.Sites;
+  sites.resize(N);
   for (vtkIdType id = 0; id < N; ++id)
   {
     sites[id] = (p.Class[id] & SkinPatch) ? 1 : 0;
   }
-  std::vector<float> work(N);
-  std::vector<int> nearest(N);
-  vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), work.data(), nearest.data());
-  std::vector<unsigned char>().swap(sites);
-  std::vector<float>().swap(work);
+  impl.Work.resize(N);
+  std::vector<int>& nearest = impl.Nearest;
+  nearest.resize(N);
+  vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), impl.Work.data(), nearest.data());
   p.Depth.resize(N);
   vtkSMPTools::For(0, p.Size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
@@ -1210,64 +1317,57 @@ namespace
 /**
  * Signed distance (mm, negative inside) of a box voxel to the shape's wall,
  * where the inner and outer strips are equally near: to first order,
- * (D_in - D_out) / |grad D_in - grad D_out|, with D the exact distances to the
- * strips' segments near the ones the transforms found.
+ * (D_in - D_out) / |grad D_in - grad D_out|, with D the exact distances to
+ * the strips' segments. The strips are offsets of the same outline points,
+ * so the nearest segments of both lie around the index of the nearest site.
  */
-float WallDistance(const PlanData& p, const double spacing[3], double minSpacing, double maxSpacing, vtkIdType id)
+float WallDistance(const PlanData& p, const double spacing[3], double maxSpacing, vtkIdType id)
 {
   const int sx = p.Size[0];
   const vtkIdType sxy = static_cast<vtkIdType>(p.Size[0]) * p.Size[1];
-  auto position = [&](vtkIdType index) {
-    return Vec{ (p.Box[0] + static_cast<int>(index % sx)) * spacing[0], (p.Box[2] + static_cast<int>((index / sx) % p.Size[1])) * spacing[1],
-      (p.Box[4] + static_cast<int>(index / sxy)) * spacing[2] };
-  };
-  const Vec x = position(id);
-  const int siteIn = p.FeatureIn[id];
-  const int siteOut = p.FeatureOut[id];
-  if (siteIn < 0 || siteOut < 0)
-  {
-    return siteIn < 0 ? 1e3f : -1e3f;
-  }
-  // A first estimate from the sites' centres: far from the wall it is enough.
-  const Vec toIn = Sub(x, position(siteIn));
-  const Vec toOut = Sub(x, position(siteOut));
-  const double dIn = Norm(toIn);
-  const double dOut = Norm(toOut);
-  const Vec slope = Sub(dIn > 0.0 ? Scale(toIn, 1.0 / dIn) : Vec{ 0.0, 0.0, 0.0 }, dOut > 0.0 ? Scale(toOut, 1.0 / dOut) : Vec{ 0.0, 0.0, 0.0 });
-  const double estimate = (dIn - dOut) / std::max(0.05, Norm(slope));
-  if (std::abs(estimate) > 6.0 * maxSpacing)
-  {
-    return static_cast<float>(estimate);
-  }
-  // Segments within three voxels of arc on either side of the sites' own.
+  const Vec x = { (p.Box[0] + static_cast<int>(id % sx)) * spacing[0], (p.Box[2] + static_cast<int>((id / sx) % p.Size[1])) * spacing[1],
+    (p.Box[4] + static_cast<int>(id / sxy)) * spacing[2] };
+  const auto found = p.StripSites.find(p.Feature[id]);
   const int n = static_cast<int>(p.Points.size());
-  const double arcStep = std::max(1e-6, p.Length / n);
-  const int window = std::min(n / 2, 1 + static_cast<int>(std::ceil(3.0 * maxSpacing / arcStep)));
-  auto nearestOn = [&](const std::vector<Vec>& strip, const std::unordered_map<int, int>& segments, int site, Vec& foot) {
-    const auto found = segments.find(site);
-    const int center = found != segments.end() ? found->second : 0;
-    double best = std::numeric_limits<double>::infinity();
+  const int center = found != p.StripSites.end() ? found->second : 0;
+  auto evaluate = [&](int window) {
+    double bestIn = std::numeric_limits<double>::infinity();
+    double bestOut = std::numeric_limits<double>::infinity();
+    Vec footIn{ 0.0, 0.0, 0.0 };
+    Vec footOut{ 0.0, 0.0, 0.0 };
     for (int offset = -window; offset <= window; ++offset)
     {
       const int k = ((center + offset) % n + n) % n;
       Vec candidate;
-      const double d2 = SegmentDistance2(x, strip[k], strip[(k + 1) % n], candidate);
-      if (d2 < best)
+      double d2 = SegmentDistance2(x, p.Inner[k], p.Inner[(k + 1) % n], candidate);
+      if (d2 < bestIn)
       {
-        best = d2;
-        foot = candidate;
+        bestIn = d2;
+        footIn = candidate;
+      }
+      d2 = SegmentDistance2(x, p.Outer[k], p.Outer[(k + 1) % n], candidate);
+      if (d2 < bestOut)
+      {
+        bestOut = d2;
+        footOut = candidate;
       }
     }
-    return std::sqrt(best);
+    const double dIn = std::sqrt(bestIn);
+    const double dOut = std::sqrt(bestOut);
+    const Vec gradient = Sub(dIn > 0.0 ? Scale(Sub(x, footIn), 1.0 / dIn) : Vec{ 0.0, 0.0, 0.0 },
+      dOut > 0.0 ? Scale(Sub(x, footOut), 1.0 / dOut) : Vec{ 0.0, 0.0, 0.0 });
+    return (dIn - dOut) / std::max(0.05, Norm(gradient));
   };
-  Vec footIn;
-  Vec footOut;
-  const double exactIn = nearestOn(p.Inner, p.SegmentIn, siteIn, footIn);
-  const double exactOut = nearestOn(p.Outer, p.SegmentOut, siteOut, footOut);
-  const Vec gradient = Sub(exactIn > 0.0 ? Scale(Sub(x, footIn), 1.0 / exactIn) : Vec{ 0.0, 0.0, 0.0 },
-    exactOut > 0.0 ? Scale(Sub(x, footOut), 1.0 / exactOut) : Vec{ 0.0, 0.0, 0.0 });
-  (void)minSpacing;
-  return static_cast<float>((exactIn - exactOut) / std::max(0.05, Norm(gradient)));
+  // Far from the wall a rough value is enough: it only has to say which side.
+  const double rough = evaluate(1);
+  if (std::abs(rough) > 6.0 * maxSpacing)
+  {
+    return static_cast<float>(rough);
+  }
+  // Segments within three voxels of arc on either side.
+  const double arcStep = std::max(1e-6, p.Length / n);
+  const int window = std::min(n / 2, 1 + static_cast<int>(std::ceil(3.0 * maxSpacing / arcStep)));
+  return static_cast<float>(evaluate(window));
 }
 } // namespace
 
@@ -1395,7 +1495,6 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
   unsigned char* keepOut = kept->GetPointer(0);
   const float low = static_cast<float>(this->SoftTissueRange[0]);
   const float high = static_cast<float>(this->SoftTissueRange[1]);
-  const double minSpacing = impl.MinSpacing();
   const double maxSpacing = impl.MaxSpacing();
   vtkSMPTools::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
@@ -1409,7 +1508,7 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
           float& wall = p.Wall[id];
           if (std::isnan(wall))
           {
-            wall = WallDistance(p, spacing, minSpacing, maxSpacing, id);
+            wall = WallDistance(p, spacing, maxSpacing, id);
           }
           const float d = p.Depth[id];
           out[3 * target] = wall;

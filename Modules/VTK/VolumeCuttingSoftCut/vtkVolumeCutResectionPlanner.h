@@ -158,6 +158,13 @@ public:
   ///@}
 
   /**
+   * How far (mm) a point (RAS) is from the skin along the image gradient, or
+   * VTK_DOUBLE_MAX if the skin is farther than reach (mm): for checking an
+   * outline's control points before planning.
+   */
+  double GetDistanceToSkin(const double ras[3], double reach);
+
+  /**
    * Build the shape and the mask, growing the bounding box until the
    * resection's reach lies inside it. Returns false with a message for bad
    * input, keeping the previous plan.
@@ -260,6 +267,8 @@ protected:
   ~vtkVolumeCutResectionPlanner() override;
 
   bool Fail(const std::string& message) const;
+  /// Reads the anatomy's grid; false with a message for an unusable one.
+  bool UpdateGrid(const char* caller);
 
   vtkSmartPointer<vtkImageData> Anatomy;
   vtkSmartPointer<vtkMatrix4x4> IJKToRAS;
