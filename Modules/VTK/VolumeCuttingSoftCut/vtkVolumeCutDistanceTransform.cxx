@@ -11,7 +11,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
-#include "vtkSMPTools.h"
+#include "vtkVolumeCutSoftCutThreads.h"
 #include "vtkStreamingDemandDrivenPipeline.h"
 
 #include <algorithm>
@@ -37,8 +37,16 @@ struct Scratch
   std::vector<int> OutFeatures;
   std::vector<int> Parabolas;
   std::vector<double> Bounds;
-  void Reserve(int length)
+  std::vector<double> Roots;
+  std::vector<double> Inverse;
+  void Reserve(int length, double s2)
   {
+    this->Roots.resize(length);
+    this->Inverse.resize(length);
+    for (int d = 1; d < length; ++d)
+    {
+      this->Inverse[d] = 1.0 / (2.0 * s2 * d);
+    }
     this->Values.resize(static_cast<size_t>(TileWidth) * length);
     this->Features.resize(static_cast<size_t>(TileWidth) * length);
     this->OutValues.resize(static_cast<size_t>(TileWidth) * length);
@@ -52,8 +60,10 @@ struct Scratch
  * One line of a pass along an axis of spacing s: out[x] = min_q f[q] + (s (x - q))^2
  * and the feature of the minimising q; the lower envelope of the parabolas
  * rooted at the finite f[q], in one sweep to build it and one to read it.
+ * inverse[d] is 1 / (2 s^2 d): the crossings divide by nothing.
  */
-void EnvelopeLine(const float* f, const int* features, int n, double s2, int* parabolas, double* bounds, float* out, int* outFeatures)
+void EnvelopeLine(const float* f, const int* features, int n, double s2, const double* inverse, int* parabolas, double* bounds, double* roots,
+  float* out, int* outFeatures)
 {
   int k = -1;
   for (int q = 0; q < n; ++q)
@@ -67,6 +77,7 @@ void EnvelopeLine(const float* f, const int* features, int n, double s2, int* pa
     {
       k = 0;
       parabolas[0] = q;
+      roots[0] = rootQ;
       bounds[0] = -std::numeric_limits<double>::infinity();
       bounds[1] = std::numeric_limits<double>::infinity();
       continue;
@@ -76,8 +87,7 @@ void EnvelopeLine(const float* f, const int* features, int n, double s2, int* pa
     {
       // Where parabola q starts to lie below the last one of the envelope;
       // bounds[0] is -infinity, so the loop stops at k = 0.
-      const int p = parabolas[k];
-      crossing = (rootQ - (f[p] + s2 * double(p) * double(p))) / (2.0 * s2 * double(q - p));
+      crossing = (rootQ - roots[k]) * inverse[q - parabolas[k]];
       if (crossing > bounds[k])
       {
         break;
@@ -86,6 +96,7 @@ void EnvelopeLine(const float* f, const int* features, int n, double s2, int* pa
     }
     ++k;
     parabolas[k] = q;
+    roots[k] = rootQ;
     bounds[k] = crossing;
     bounds[k + 1] = std::numeric_limits<double>::infinity();
   }
@@ -115,7 +126,7 @@ void RowPass(const int dims[3], double sx, const unsigned char* sites, float* di
   const vtkIdType rows = static_cast<vtkIdType>(dims[1]) * dims[2];
   const int nx = dims[0];
   const double s2 = sx * sx;
-  vtkSMPTools::For(0, rows, [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, rows, [&](vtkIdType begin, vtkIdType end) {
     std::vector<int> left(nx);
     for (vtkIdType row = begin; row < end; ++row)
     {
@@ -173,9 +184,9 @@ void ColumnPass(const int dims[3], int axis, double spacing, float* distances, i
   const vtkIdType otherStride = axis == 1 ? static_cast<vtkIdType>(nx) * dims[1] : nx;
   const int tilesPerRow = (nx + TileWidth - 1) / TileWidth;
   const double s2 = spacing * spacing;
-  vtkSMPTools::For(0, static_cast<vtkIdType>(tilesPerRow) * others, [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, static_cast<vtkIdType>(tilesPerRow) * others, [&](vtkIdType begin, vtkIdType end) {
     Scratch scratch;
-    scratch.Reserve(length);
+    scratch.Reserve(length, s2);
     for (vtkIdType tile = begin; tile < end; ++tile)
     {
       const int x0 = static_cast<int>(tile % tilesPerRow) * TileWidth;
@@ -199,8 +210,8 @@ void ColumnPass(const int dims[3], int axis, double spacing, float* distances, i
         if (anySite[t])
         {
           anyLine = true;
-          EnvelopeLine(&scratch.Values[t * length], &scratch.Features[t * length], length, s2, scratch.Parabolas.data(), scratch.Bounds.data(),
-            &scratch.OutValues[t * length], &scratch.OutFeatures[t * length]);
+          EnvelopeLine(&scratch.Values[t * length], &scratch.Features[t * length], length, s2, scratch.Inverse.data(), scratch.Parabolas.data(),
+            scratch.Bounds.data(), scratch.Roots.data(), &scratch.OutValues[t * length], &scratch.OutFeatures[t * length]);
         }
       }
       if (!anyLine)
@@ -302,7 +313,7 @@ int vtkVolumeCutDistanceTransform::RequestData(vtkInformation*, vtkInformationVe
   if (!this->OutputSquaredDistance)
   {
     float* values = distances->GetPointer(0);
-    vtkSMPTools::For(0, count, [values](vtkIdType begin, vtkIdType end) {
+    vtkVolumeCutSoftCutThreads::For(0, count, [values](vtkIdType begin, vtkIdType end) {
       for (vtkIdType id = begin; id < end; ++id)
       {
         values[id] = std::sqrt(values[id]);

@@ -15,7 +15,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
-#include "vtkSMPTools.h"
+#include "vtkVolumeCutSoftCutThreads.h"
 #include "vtkUnsignedCharArray.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutProtection.h"
@@ -103,7 +103,7 @@ template <typename T>
 void CopyBox(const T* data, const int dims[3], const int box[6], float* out)
 {
   const int size[3] = { box[1] - box[0] + 1, box[3] - box[2] + 1, box[5] - box[4] + 1 };
-  vtkSMPTools::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
     {
       for (int b = 0; b < size[1]; ++b)
@@ -150,7 +150,10 @@ struct PlanData
   /// Each voxel's nearest strip site, and each site's outline segment.
   std::vector<int> Feature;
   std::unordered_map<int, int> StripSites;
+  /// The skin's voxels inside the outline (the patch), in the order found.
+  std::vector<vtkIdType> Skin;
   std::vector<float> Wall; // NaN until needed
+  std::vector<float> Bone; // NaN until needed
   std::vector<float> Depth;
   vtkIdType FilledCount = 0;
   bool NearFilledReady = false;
@@ -159,9 +162,27 @@ struct PlanData
   bool Reached[6] = { false, false, false, false, false, false };
 
   vtkIdType Index(int a, int b, int c) const { return (static_cast<vtkIdType>(c) * this->Size[1] + b) * this->Size[0] + a; }
+
+  /// Ready for a new plan, keeping the arrays' memory (touching fresh pages
+  /// costs a plan of a million voxels milliseconds).
+  void Reset()
+  {
+    for (std::vector<Vec>* points : { &this->Points, &this->Normals, &this->Inner, &this->Outer })
+    {
+      points->clear();
+    }
+    this->StripSites.clear();
+    this->Skin.clear();
+    this->FilledCount = 0;
+    this->NearFilledReady = false;
+    this->MaskReady = false;
+    std::fill(this->Reached, this->Reached + 6, false);
+  }
 };
 
 constexpr uint8_t NearFilled = 8;
+/// Components of the region's distances: wall, depth, air margin, bone.
+constexpr int RegionComponents = 4;
 
 //------------------------------------------------------------------------------
 struct vtkVolumeCutResectionPlanner::Internals
@@ -175,6 +196,18 @@ struct vtkVolumeCutResectionPlanner::Internals
 
   std::unique_ptr<PlanData> Current;
   std::unique_ptr<PlanData> Next;
+  /// A plan no longer needed, whose arrays the next one reuses.
+  std::unique_ptr<PlanData> Spare;
+  std::unique_ptr<PlanData> NewPlan()
+  {
+    std::unique_ptr<PlanData> plan = std::move(this->Spare);
+    if (!plan)
+    {
+      plan.reset(new PlanData);
+    }
+    plan->Reset();
+    return plan;
+  }
   /// Working arrays of the transforms, kept between plans (a new plan of
   /// the same size then touches no fresh memory).
   std::vector<unsigned char> Sites;
@@ -757,7 +790,11 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
   }
   const double total = arc.back();
   const int samples = static_cast<int>(std::min(20000.0, std::max(static_cast<double>(given.size()), std::ceil(total / (0.5 * impl.MinSpacing())))));
-  auto plan = std::unique_ptr<PlanData>(new PlanData);
+  if (impl.Next)
+  {
+    impl.Spare = std::move(impl.Next);
+  }
+  auto plan = impl.NewPlan();
   plan->Points.resize(samples);
   const double reach = std::max(this->SkinTolerance, 3.0 * impl.MaxSpacing());
   size_t segment = 0;
@@ -790,18 +827,18 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
   // 2. Normals (outward: the inverse gradient). A sharp skin edge sampled
   // by trilinear interpolation has terraces whose gradients tilt by several
   // degrees, which would tilt the wall: the gradient is averaged over a box
-  // of five voxels, at points about a voxel apart along the outline, then
+  // of five voxels, at points about two voxels apart along the outline, then
   // smoothed along the outline over two voxels on either side.
   std::vector<Vec> local(n);
   {
-    const int stride = std::max(1, static_cast<int>(std::lround(impl.MinSpacing() / step)));
+    const int stride = std::max(1, static_cast<int>(std::lround(2.0 * impl.MinSpacing() / step)));
     std::vector<int> at;
     for (int k = 0; k < n; k += stride)
     {
       at.push_back(k);
     }
     std::vector<Vec> sampled(at.size());
-    vtkSMPTools::For(0, static_cast<vtkIdType>(at.size()), [&](vtkIdType begin, vtkIdType end) {
+    vtkVolumeCutSoftCutThreads::For(0, static_cast<vtkIdType>(at.size()), [&](vtkIdType begin, vtkIdType end) {
       for (vtkIdType m = begin; m < end; ++m)
       {
         sampled[m] = Normalized(Scale(impl.BoxGradient(plan->Points[at[m]], 2), -1.0));
@@ -997,7 +1034,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
   impl.Work.resize(N);
   vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), impl.Work.data(), p.Feature.data());
   p.Class.resize(N);
-  vtkSMPTools::For(0, N, [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, N, [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType id = begin; id < end; ++id)
     {
       const int site = p.Feature[id];
@@ -1063,6 +1100,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
     {
       p.Class[bestId] |= SkinPatch;
       stack.push_back(bestId);
+      p.Skin.push_back(bestId);
     }
   }
   if (stack.empty())
@@ -1093,6 +1131,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
           const vtkIdType neighbour = p.Index(q[0], q[1], q[2]);
           p.Class[neighbour] |= SkinPatch;
           stack.push_back(neighbour);
+          p.Skin.push_back(neighbour);
         }
       }
     }
@@ -1102,12 +1141,14 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
   // the shape: bone and air stop it.
   const float low = static_cast<float>(this->SoftTissueRange[0]);
   const float high = static_cast<float>(this->SoftTissueRange[1]);
-  for (vtkIdType id = 0; id < N; ++id)
+  p.FilledCount = 0;
+  for (const vtkIdType id : p.Skin)
   {
-    if ((p.Class[id] & SkinPatch) && p.Values[id] >= low && p.Values[id] <= high)
+    if (p.Values[id] >= low && p.Values[id] <= high)
     {
       p.Class[id] |= FilledTissue;
       stack.push_back(id);
+      ++p.FilledCount;
     }
   }
   const vtkIdType faceSteps[6] = { -1, 1, -sx, sx, -sxy, sxy };
@@ -1131,23 +1172,19 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
       {
         p.Class[neighbour] = cls | FilledTissue;
         stack.push_back(neighbour);
+        ++p.FilledCount;
       }
     }
   }
-  p.FilledCount = 0;
-  for (vtkIdType id = 0; id < N; ++id)
+  for (const vtkIdType id : p.Skin)
   {
-    if (p.Class[id] & SkinPatch)
+    // The skin reaching a face of the box that is not the CT's: grow there.
+    const int position[3] = { static_cast<int>(id % sx), static_cast<int>((id / sx) % p.Size[1]), static_cast<int>(id / sxy) };
+    for (int a = 0; a < 3; ++a)
     {
-      // The skin reaching a face of the box that is not the CT's: grow there.
-      const int position[3] = { static_cast<int>(id % sx), static_cast<int>((id / sx) % p.Size[1]), static_cast<int>(id / sxy) };
-      for (int a = 0; a < 3; ++a)
-      {
-        p.Reached[2 * a] |= position[a] == 0 && p.Box[2 * a] > 0;
-        p.Reached[2 * a + 1] |= position[a] == p.Size[a] - 1 && p.Box[2 * a + 1] < dims[a] - 1;
-      }
+      p.Reached[2 * a] |= position[a] == 0 && p.Box[2 * a] > 0;
+      p.Reached[2 * a + 1] |= position[a] == p.Size[a] - 1 && p.Box[2 * a + 1] < dims[a] - 1;
     }
-    p.FilledCount += (p.Class[id] & FilledTissue) ? 1 : 0;
   }
   if (p.FilledCount == 0)
   {
@@ -1156,7 +1193,7 @@ bool vtkVolumeCutResectionPlanner::BuildShape()
          << " HU) under the skin; nothing to resect there";
     return this->Fail(text.str());
   }
-  p.Wall.assign(N, std::numeric_limits<float>::quiet_NaN());
+
   impl.Next = std::move(plan);
   return true;
 }
@@ -1180,14 +1217,13 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
   // normal there.
   std::vector<int>& slot = impl.Scratch;
   slot.resize(N);
-  std::vector<vtkIdType> skin;
-  for (vtkIdType id = 0; id < N; ++id)
+  const std::vector<vtkIdType>& skin = p.Skin;
+  std::vector<unsigned char>& sites = impl.Sites;
+  sites.assign(N, 0);
+  for (size_t s = 0; s < skin.size(); ++s)
   {
-    if (p.Class[id] & SkinPatch)
-    {
-      slot[id] = static_cast<int>(skin.size());
-      skin.push_back(id);
-    }
+    slot[skin[s]] = static_cast<int>(s);
+    sites[skin[s]] = 1;
   }
   const int sx = p.Size[0];
   const vtkIdType sxy = static_cast<vtkIdType>(p.Size[0]) * p.Size[1];
@@ -1196,7 +1232,7 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
       (p.Box[4] + static_cast<int>(id / sxy)) * spacing[2] };
   };
   std::vector<float> surface(6 * skin.size());
-  vtkSMPTools::For(0, static_cast<vtkIdType>(skin.size()), [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, static_cast<vtkIdType>(skin.size()), [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType s = begin; s < end; ++s)
     {
       const Vec center = position(skin[s]);
@@ -1214,7 +1250,7 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
       if (Norm(normal) > 0.0)
       {
         // The voxel is tissue; air lies against the gradient within two voxels.
-        const double stepLength = 0.25 * impl.MinSpacing();
+        const double stepLength = 0.5 * impl.MinSpacing();
         double previous = 0.0;
         for (double t = stepLength; t <= 2.0 * impl.MaxSpacing() + 1e-9; t += stepLength)
         {
@@ -1222,7 +1258,7 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
           {
             double lo = previous;
             double hi = t;
-            for (int iteration = 0; iteration < 14; ++iteration)
+            for (int iteration = 0; iteration < 12; ++iteration)
             {
               const double mid = 0.5 * (lo + hi);
               (Internals::BoxSample(p, spacing, Sub(center, Scale(normal, mid))) < iso ? hi : lo) = mid;
@@ -1247,18 +1283,12 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
 
   // The third transform: every voxel's nearest skin voxel, then its depth
   // under that voxel's tangent plane.
-  std::vector<unsigned char>& sites = impl.Sites;
-  sites.resize(N);
-  for (vtkIdType id = 0; id < N; ++id)
-  {
-    sites[id] = (p.Class[id] & SkinPatch) ? 1 : 0;
-  }
   impl.Work.resize(N);
   std::vector<int>& nearest = impl.Nearest;
   nearest.resize(N);
   vtkVolumeCutDistanceTransform::Compute(p.Size, spacing, sites.data(), impl.Work.data(), nearest.data());
   p.Depth.resize(N);
-  vtkSMPTools::For(0, p.Size[2], [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, p.Size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
     {
       const double z = (p.Box[4] + c) * spacing[2];
@@ -1297,10 +1327,11 @@ bool vtkVolumeCutResectionPlanner::BuildMask()
     std::ostringstream text;
     text << "BuildMask: the outline encloses no soft tissue (CT values " << this->SoftTissueRange[0] << " to " << this->SoftTissueRange[1]
          << " HU) more than a voxel under the skin; nothing to resect there";
-    impl.Next.reset();
+    impl.Spare = std::move(impl.Next);
     return this->Fail(text.str());
   }
   p.MaskReady = true;
+  impl.Spare = std::move(impl.Current);
   impl.Current = std::move(impl.Next);
   return true;
 }
@@ -1369,7 +1400,71 @@ float WallDistance(const PlanData& p, const double spacing[3], double maxSpacing
   const int window = std::min(n / 2, 1 + static_cast<int>(std::ceil(3.0 * maxSpacing / arcStep)));
   return static_cast<float>(evaluate(window));
 }
+
+/**
+ * Signed distance (mm, positive inside bone) of a box voxel to the CT's
+ * iso-surface at the top of the soft-tissue range, to first order: (CT -
+ * threshold) / |gradient|, clamped to a few voxels. The resection stops at
+ * that smooth surface, so the print of the bone it leaves is the bone's
+ * shape, not voxel steps (the bone's voxel cubes are kept besides).
+ */
+float BoneDistance(const PlanData& p, const double spacing[3], double maxSpacing, float threshold, vtkIdType id)
+{
+  const int at[3] = { static_cast<int>(id % p.Size[0]), static_cast<int>((id / p.Size[0]) % p.Size[1]),
+    static_cast<int>(id / (static_cast<vtkIdType>(p.Size[0]) * p.Size[1])) };
+  const vtkIdType steps[3] = { 1, p.Size[0], static_cast<vtkIdType>(p.Size[0]) * p.Size[1] };
+  double gradient2 = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    const vtkIdType up = at[a] + 1 < p.Size[a] ? id + steps[a] : id;
+    const vtkIdType down = at[a] > 0 ? id - steps[a] : id;
+    const double g = (p.Values[up] - p.Values[down]) / (spacing[a] * ((up != id) + (down != id)));
+    gradient2 += g * g;
+  }
+  // Flat regions (inside tissue or bone) are far from the surface anyway.
+  const double slope = std::max(std::sqrt(gradient2), 50.0);
+  const double reach = 4.0 * maxSpacing;
+  return static_cast<float>(std::max(-reach, std::min(reach, (p.Values[id] - threshold) / slope)));
+}
+
+/**
+ * Whether a box voxel is bone through and through: its value and its 26
+ * neighbours' are above the soft-tissue range. Its cube is kept exactly;
+ * the voxels of the bone's surface, mixtures of bone and soft tissue, are
+ * kept by the smooth surface of BoneDistance up to their centres.
+ */
+bool IsInsideBone(const PlanData& p, vtkIdType id, float threshold)
+{
+  if (!(p.Values[id] > threshold))
+  {
+    return false;
+  }
+  const int at[3] = { static_cast<int>(id % p.Size[0]), static_cast<int>((id / p.Size[0]) % p.Size[1]),
+    static_cast<int>(id / (static_cast<vtkIdType>(p.Size[0]) * p.Size[1])) };
+  for (int a = 0; a < 3; ++a)
+  {
+    if (at[a] == 0 || at[a] + 1 == p.Size[a])
+    {
+      return false;
+    }
+  }
+  for (int dc = -1; dc <= 1; ++dc)
+  {
+    for (int db = -1; db <= 1; ++db)
+    {
+      for (int da = -1; da <= 1; ++da)
+      {
+        if (!(p.Values[p.Index(at[0] + da, at[1] + db, at[2] + dc)] > threshold))
+        {
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
 } // namespace
+
 
 //------------------------------------------------------------------------------
 bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* distances, vtkImageData* keep, vtkVolumeCutField* shieldSource)
@@ -1404,9 +1499,12 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
   const vtkIdType sxy = static_cast<vtkIdType>(p.Size[0]) * p.Size[1];
 
   // Voxels next to filled tissue (26-neighbours): removable, so that the
-  // smooth wall and depth, not voxel cubes, bound the region.
+  // smooth wall and depth, not voxel cubes, bound the region. The wall's and
+  // the bone's distances are computed where a region first needs them.
   if (!p.NearFilledReady)
   {
+    p.Wall.assign(p.Count, std::numeric_limits<float>::quiet_NaN());
+    p.Bone.assign(p.Count, std::numeric_limits<float>::quiet_NaN());
     std::vector<uint8_t> near(p.Count);
     for (vtkIdType id = 0; id < p.Count; ++id)
     {
@@ -1472,7 +1570,7 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
   distances->SetSpacing(1.0, 1.0, 1.0);
   vtkNew<vtkFloatArray> values;
   values->SetName("ResectionDistance");
-  values->SetNumberOfComponents(3);
+  values->SetNumberOfComponents(RegionComponents);
   values->SetNumberOfTuples(count);
   distances->GetPointData()->SetScalars(values);
   keep->Initialize();
@@ -1496,7 +1594,7 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
   const float low = static_cast<float>(this->SoftTissueRange[0]);
   const float high = static_cast<float>(this->SoftTissueRange[1]);
   const double maxSpacing = impl.MaxSpacing();
-  vtkSMPTools::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
     {
       for (int b = 0; b < size[1]; ++b)
@@ -1510,14 +1608,20 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
           {
             wall = WallDistance(p, spacing, maxSpacing, id);
           }
+          float& bone = p.Bone[id];
+          if (std::isnan(bone))
+          {
+            bone = BoneDistance(p, spacing, maxSpacing, high, id);
+          }
           const float d = p.Depth[id];
-          out[3 * target] = wall;
-          out[3 * target + 1] = static_cast<float>(d - depth);
-          out[3 * target + 2] = static_cast<float>(-(d + margin));
+          float* components = out + RegionComponents * target;
+          components[0] = wall;
+          components[1] = static_cast<float>(d - depth);
+          components[2] = static_cast<float>(-(d + margin));
+          components[3] = bone;
           const float value = p.Values[id];
-          const bool bone = value > high;
           const bool unreached = value >= low && !(p.Class[id] & NearFilled);
-          keepOut[target] = (bone || unreached || (!shield.empty() && shield[target])) ? 1 : 0;
+          keepOut[target] = (IsInsideBone(p, id, high) || unreached || (!shield.empty() && shield[target])) ? 1 : 0;
         }
       }
     }
@@ -1583,20 +1687,16 @@ bool vtkVolumeCutResectionPlanner::BuildResectedTissueFunction(double depth, int
     }
   }
   const float* region = static_cast<float*>(distances->GetScalarPointer());
-  // Components: wall, depth - depth of cut, -depth (the skin), kept cubes.
+  // The region's components with the skin itself (-depth) for the air
+  // margin's, and the kept cubes.
   auto component = [&](int a, int b, int c, int which) -> float {
     const size_t id = (static_cast<size_t>(c) * size[1] + b) * size[0] + a;
-    switch (which)
+    if (which == RegionComponents)
     {
-      case 0:
-        return region[3 * id];
-      case 1:
-        return region[3 * id + 1];
-      case 2:
-        return static_cast<float>(region[3 * id + 2] + margin);
-      default:
-        return kept[id];
+      return kept[id];
     }
+    const float value = region[RegionComponents * id + which];
+    return which == 2 ? static_cast<float>(value + margin) : value;
   };
   // One sample of padding, positive, closes the surface at the image's faces.
   const int s = subdivision;
@@ -1610,7 +1710,7 @@ bool vtkVolumeCutResectionPlanner::BuildResectedTissueFunction(double depth, int
   values->SetNumberOfTuples(static_cast<vtkIdType>(samples[0]) * samples[1] * samples[2]);
   function->GetPointData()->SetScalars(values);
   float* out = values->GetPointer(0);
-  vtkSMPTools::For(0, samples[2], [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutSoftCutThreads::For(0, samples[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType qz = begin; qz < end; ++qz)
     {
       for (int qy = 0; qy < samples[1]; ++qy)
@@ -1633,7 +1733,7 @@ bool vtkVolumeCutResectionPlanner::BuildResectedTissueFunction(double depth, int
             f[a] = size[a] > 1 ? double(local) / s - base[a] : 0.0;
           }
           float result = -std::numeric_limits<float>::infinity();
-          for (int which = 0; which < 4; ++which)
+          for (int which = 0; which <= RegionComponents; ++which)
           {
             double value = 0.0;
             for (int corner = 0; corner < 8; ++corner)

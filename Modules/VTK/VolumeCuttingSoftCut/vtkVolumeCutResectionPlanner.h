@@ -231,11 +231,13 @@ public:
 
   /**
    * The resection at a depth of cut (mm) as vtkVolumeCutField::CutSampledRegion
-   * takes it: distances (three float components over the part of the box the
-   * region reaches: the wall, the depth minus the depth of cut, and the
-   * height above the skin minus a margin of two voxels, so that the skin is
-   * opened cleanly) and keep (unsigned char: 1 for voxels never removed,
-   * bone and tissue the fill did not reach). A field given as shieldSource
+   * takes it: distances (four float components over the part of the box the
+   * region reaches: the wall, the depth minus the depth of cut, the height
+   * above the skin minus a margin of two voxels, so that the skin is opened
+   * cleanly, and the distance into bone, the CT's iso-surface at the top of
+   * the soft-tissue range, so that the print the resection leaves on bone is
+   * smooth) and keep (unsigned char: 1 for voxels never removed, bone and
+   * tissue the fill did not reach). A field given as shieldSource
    * adds its shielded voxels to keep (for a preview field that should show
    * what the real carve will leave). False with a message for a depth that
    * is not positive or beyond MaximumDepth, or without a plan.

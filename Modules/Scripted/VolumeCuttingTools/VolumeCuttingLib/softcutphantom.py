@@ -64,8 +64,32 @@ class SpherePhantom:
         return np.linalg.norm(self.voxel_centers_ras() - self.center, axis=-1)
 
     def bone_voxels(self, threshold=BONE_THRESHOLD_HU):
-        """The voxels SoftCut must never carve: CT above the soft-tissue range."""
+        """Voxels whose CT lies above the soft-tissue range (bone and the bone's partial-volume surface)."""
         return self.ct > threshold
+
+    def interior_bone_voxels(self, threshold=BONE_THRESHOLD_HU):
+        """Bone through and through: the voxel and its 26 neighbours above the soft-tissue range."""
+        bone = self.bone_voxels(threshold)
+        interior = bone.copy()
+        for dk in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                for di in (-1, 0, 1):
+                    interior &= np.roll(bone, (dk, dj, di), axis=(0, 1, 2))
+        interior[[0, -1], :, :] = interior[:, [0, -1], :] = interior[:, :, [0, -1]] = False
+        return interior
+
+    def bone_fraction(self, voxels_kji, samples=4):
+        """The part (0..1) of each voxel's cube inside the analytic bone shell, by samples^3 points."""
+        voxels = np.asarray(voxels_kji, dtype=float).reshape(-1, 3)
+        offsets = (np.arange(samples) + 0.5) / samples - 0.5
+        grid = np.stack(np.meshgrid(offsets, offsets, offsets, indexing="ij"), axis=-1).reshape(-1, 3)
+        fractions = np.zeros(len(voxels))
+        for offset in grid:
+            ijk = voxels[:, ::-1] + offset
+            ras = ijk @ self.ijk_to_ras[:3, :3].T + self.ijk_to_ras[:3, 3]
+            r = np.linalg.norm(ras - self.center, axis=1)
+            fractions += (r >= self.bone_inner) & (r <= self.bone_outer)
+        return fractions / len(grid)
 
 
 def smooth_step(x, width):
