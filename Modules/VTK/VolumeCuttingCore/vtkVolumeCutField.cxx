@@ -551,6 +551,7 @@ bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* 
   double spacing[3];
   this->GetSubVoxelSpacing(spacing);
   vtkSmartPointer<vtkVolumeCutProtection> keepOut;
+  std::vector<char> keepBricks;
   if (keep)
   {
     // The keep-out set is a shield of its own, built where the region reaches.
@@ -565,6 +566,47 @@ bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* 
     for (int value = 1; value <= largest; ++value)
     {
       keepOut->SetShieldLabel(image, value, 1);
+    }
+    // The bricks a kept voxel's cube comes within the band of: only those
+    // need the keep-out shield built (most of a region has none).
+    const int* extent = keep->GetExtent();
+    keepBricks.assign(static_cast<size_t>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2], 0);
+    int reach[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      reach[axis] = static_cast<int>(std::ceil(this->BandWidth / anatomySpacing[axis])) + 1;
+    }
+    vtkIdType id = 0;
+    for (int k = extent[4]; k <= extent[5]; ++k)
+    {
+      for (int j = extent[2]; j <= extent[3]; ++j)
+      {
+        for (int i = extent[0]; i <= extent[1]; ++i, ++id)
+        {
+          if (!(keepValues->GetComponent(id, 0) > 0.0))
+          {
+            continue;
+          }
+          const int voxel[3] = { i, j, k };
+          int lower[3];
+          int upper[3];
+          for (int axis = 0; axis < 3; ++axis)
+          {
+            lower[axis] = std::max(0, (voxel[axis] - reach[axis]) * f / BrickSize);
+            upper[axis] = std::min(this->BrickDimensions[axis] - 1, ((voxel[axis] + reach[axis] + 1) * f - 1) / BrickSize);
+          }
+          for (int bk = lower[2]; bk <= upper[2]; ++bk)
+          {
+            for (int bj = lower[1]; bj <= upper[1]; ++bj)
+            {
+              for (int bi = lower[0]; bi <= upper[0]; ++bi)
+              {
+                keepBricks[(static_cast<size_t>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi] = 1;
+              }
+            }
+          }
+        }
+      }
     }
   }
   vtkNew<vtkMatrix4x4> ijkToRAS;
@@ -582,7 +624,7 @@ bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* 
     }
   }
   const vtkVolumeCutSweeps::SampledRegionSource source(samples, components, distances->GetExtent(), rasToIJKRows, ijkToRASRows, this->BandWidth,
-    keepOut, this->RASToSubIJK, this->BrickDimensions, this->Quantum, 0.5 * std::max({ spacing[0], spacing[1], spacing[2] }));
+    keepOut, this->RASToSubIJK, this->BrickDimensions, this->Quantum, 0.5 * std::max({ spacing[0], spacing[1], spacing[2] }), keepBricks);
   this->ApplyDistance(source, Operation::Cut);
   this->LastCapsule.Valid = false;
   return true;

@@ -27,7 +27,7 @@ void Transform(const double m[4][4], const double in[3], double out[3])
 //------------------------------------------------------------------------------
 SampledRegionSource::SampledRegionSource(const float* values, int components, const int extent[6], const double rasToIJK[4][4],
   const double ijkToRAS[4][4], double bandWidth, vtkVolumeCutProtection* keep, const double rasToSubIJK[4][4], const int brickDimensions[3],
-  double quantum, double keepMargin)
+  double quantum, double keepMargin, const std::vector<char>& keepBricks)
   : Values(values)
   , Components(components)
   , Quantum(quantum)
@@ -35,6 +35,7 @@ SampledRegionSource::SampledRegionSource(const float* values, int components, co
   , KeepMargin(keepMargin)
   , Far(static_cast<float>(4.0 * bandWidth))
   , Keep(keep)
+  , KeepBricks(keepBricks)
 {
   std::copy(extent, extent + 6, this->Extent);
   std::copy(brickDimensions, brickDimensions + 3, this->BrickDimensions);
@@ -232,7 +233,12 @@ void SampledRegionSource::BrickDistances(const double origin[3], const double*, 
   {
     brick[axis] = static_cast<vtkIdType>(std::lround(sub[axis])) / BrickSize;
   }
-  const vtkVolumeCutProtection::Brick* kept = this->Keep->GetBrick((brick[2] * this->BrickDimensions[1] + brick[1]) * this->BrickDimensions[0] + brick[0]);
+  const vtkIdType brickId = (brick[2] * this->BrickDimensions[1] + brick[1]) * this->BrickDimensions[0] + brick[0];
+  if (!this->KeepBricks[brickId])
+  {
+    return;
+  }
+  const vtkVolumeCutProtection::Brick* kept = this->Keep->GetBrick(brickId);
   if (!kept)
   {
     return;

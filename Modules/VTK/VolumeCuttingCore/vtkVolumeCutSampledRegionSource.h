@@ -32,10 +32,11 @@ public:
    * marks the voxels never removed. rasToSubIJK, brickDimensions and
    * quantum: the field's sub-voxel grid, bricks and unit, for the keep-out
    * bricks. keepMargin (mm): how far the region stays from the kept cubes.
+   * keepBricks: by brick ID, whether a kept cube comes within the band.
    */
   SampledRegionSource(const float* values, int components, const int extent[6], const double rasToIJK[4][4], const double ijkToRAS[4][4],
     double bandWidth, vtkVolumeCutProtection* keep, const double rasToSubIJK[4][4], const int brickDimensions[3], double quantum,
-    double keepMargin);
+    double keepMargin, const std::vector<char>& keepBricks);
   void GetReachBounds(double lower[3], double upper[3]) const override;
   double Distance(const double point[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
@@ -59,6 +60,7 @@ private:
   /// Farther than any distance the field keeps: voxels outside the box.
   float Far;
   vtkVolumeCutProtection* Keep;
+  const std::vector<char>& KeepBricks;
   /// Per block of BlockSize^3 voxels and component: the smallest value (a
   /// lower bound of the interpolation inside the block's cells).
   static constexpr int BlockSize = 4;

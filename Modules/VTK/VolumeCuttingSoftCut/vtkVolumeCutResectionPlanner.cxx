@@ -1402,27 +1402,16 @@ float WallDistance(const PlanData& p, const double spacing[3], double maxSpacing
 }
 
 /**
- * Signed distance (mm, positive inside bone) of a box voxel to the CT's
- * iso-surface at the top of the soft-tissue range, to first order: (CT -
- * threshold) / |gradient|, clamped to a few voxels. The resection stops at
- * that smooth surface, so the print of the bone it leaves is the bone's
- * shape, not voxel steps (the bone's voxel cubes are kept besides).
+ * The bone's side (positive inside bone) of the CT's iso-surface at the top
+ * of the soft-tissue range, as a distance-like value (mm): (CT - threshold)
+ * / slope, clamped to a few voxels, with one slope for the whole box (the
+ * jump from soft tissue to the threshold over two voxels), so that its
+ * trilinear zero set is exactly the CT's trilinear iso-surface. The
+ * resection stops at that smooth surface, so the print it leaves on bone is
+ * the bone's shape, not voxel steps.
  */
-float BoneDistance(const PlanData& p, const double spacing[3], double maxSpacing, float threshold, vtkIdType id)
+float BoneDistance(const PlanData& p, double slope, double maxSpacing, float threshold, vtkIdType id)
 {
-  const int at[3] = { static_cast<int>(id % p.Size[0]), static_cast<int>((id / p.Size[0]) % p.Size[1]),
-    static_cast<int>(id / (static_cast<vtkIdType>(p.Size[0]) * p.Size[1])) };
-  const vtkIdType steps[3] = { 1, p.Size[0], static_cast<vtkIdType>(p.Size[0]) * p.Size[1] };
-  double gradient2 = 0.0;
-  for (int a = 0; a < 3; ++a)
-  {
-    const vtkIdType up = at[a] + 1 < p.Size[a] ? id + steps[a] : id;
-    const vtkIdType down = at[a] > 0 ? id - steps[a] : id;
-    const double g = (p.Values[up] - p.Values[down]) / (spacing[a] * ((up != id) + (down != id)));
-    gradient2 += g * g;
-  }
-  // Flat regions (inside tissue or bone) are far from the surface anyway.
-  const double slope = std::max(std::sqrt(gradient2), 50.0);
   const double reach = 4.0 * maxSpacing;
   return static_cast<float>(std::max(-reach, std::min(reach, (p.Values[id] - threshold) / slope)));
 }
@@ -1594,6 +1583,10 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
   const float low = static_cast<float>(this->SoftTissueRange[0]);
   const float high = static_cast<float>(this->SoftTissueRange[1]);
   const double maxSpacing = impl.MaxSpacing();
+  // A voxel's cube meets the region only where the region's value at its
+  // centre is below the cube's half diagonal.
+  const float nearKept = static_cast<float>(maxSpacing);
+  const double boneSlope = std::max(1.0, this->SoftTissueRange[1] - this->SoftTissueRange[0]) / (2.0 * maxSpacing);
   vtkVolumeCutSoftCutThreads::For(0, size[2], [&](vtkIdType begin, vtkIdType end) {
     for (vtkIdType c = begin; c < end; ++c)
     {
@@ -1611,7 +1604,7 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
           float& bone = p.Bone[id];
           if (std::isnan(bone))
           {
-            bone = BoneDistance(p, spacing, maxSpacing, high, id);
+            bone = BoneDistance(p, boneSlope, maxSpacing, high, id);
           }
           const float d = p.Depth[id];
           float* components = out + RegionComponents * target;
@@ -1619,9 +1612,14 @@ bool vtkVolumeCutResectionPlanner::BuildRegion(double depth, vtkImageData* dista
           components[1] = static_cast<float>(d - depth);
           components[2] = static_cast<float>(-(d + margin));
           components[3] = bone;
+          // Voxels kept as cubes, where the region comes near them (farther
+          // ones change nothing, and each costs the writer a shield brick):
+          // bone through and through, and tissue the fill did not reach
+          // (behind bone or air) that the region could reach.
+          const bool near = std::max({ components[0], components[1], components[2], components[3] }) < nearKept;
           const float value = p.Values[id];
           const bool unreached = value >= low && !(p.Class[id] & NearFilled);
-          keepOut[target] = (IsInsideBone(p, id, high) || unreached || (!shield.empty() && shield[target])) ? 1 : 0;
+          keepOut[target] = ((near && (unreached || IsInsideBone(p, id, high))) || (!shield.empty() && shield[target])) ? 1 : 0;
         }
       }
     }

@@ -494,11 +494,18 @@ def sliceview(repeats: int) -> list[dict]:
     return slicebenchmarks.sliceview(repeats)
 
 
+def softcut(repeats: int) -> list[dict]:
+    from . import softcutbenchmarks
+
+    return softcutbenchmarks.softcut_area(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
     "sliceview": sliceview,
+    "softcut": softcut,
 }
 
 
