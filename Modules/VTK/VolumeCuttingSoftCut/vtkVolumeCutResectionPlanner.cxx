@@ -476,6 +476,35 @@ struct vtkVolumeCutResectionPlanner::Internals
     polyline->SetLines(lines);
   }
 
+  /// One of the current plan's polylines (outline, strips) in RAS; empty without a plan.
+  void CopyPolyline(std::vector<Vec> PlanData::*which, vtkPolyData* polyline) const
+  {
+    if (polyline)
+    {
+      polyline->Initialize();
+      if (this->Current)
+      {
+        this->MakePolyline(this->Current.get()->*which, polyline);
+      }
+    }
+  }
+
+  /// The current plan, with image emptied and given the box's extent; nullptr without either.
+  const PlanData* StartBoxImage(vtkImageData* image) const
+  {
+    if (!image)
+    {
+      return nullptr;
+    }
+    image->Initialize();
+    if (!this->Current)
+    {
+      return nullptr;
+    }
+    image->SetExtent(const_cast<int*>(this->Current->Box));
+    return this->Current.get();
+  }
+
   /// A point onto the skin along the gradient; false if the skin is beyond reach.
   bool ToSkin(const Vec& x, double reach, double iso, Vec& onSkin) const
   {
@@ -1766,42 +1795,20 @@ void vtkVolumeCutResectionPlanner::GetBoxExtent(int extent[6]) const
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetOutlineOnSkin(vtkPolyData* polyline) const
 {
-  if (polyline)
-  {
-    polyline->Initialize();
-    if (this->Impl->Current)
-    {
-      this->Impl->MakePolyline(this->Impl->Current->Points, polyline);
-    }
-  }
+  this->Impl->CopyPolyline(&PlanData::Points, polyline);
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetInnerStrip(vtkPolyData* polyline) const
 {
-  if (polyline)
-  {
-    polyline->Initialize();
-    if (this->Impl->Current)
-    {
-      this->Impl->MakePolyline(this->Impl->Current->Inner, polyline);
-    }
-  }
+  this->Impl->CopyPolyline(&PlanData::Inner, polyline);
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetOuterStrip(vtkPolyData* polyline) const
 {
-  if (polyline)
-  {
-    polyline->Initialize();
-    if (this->Impl->Current)
-    {
-      this->Impl->MakePolyline(this->Impl->Current->Outer, polyline);
-    }
-  }
+  this->Impl->CopyPolyline(&PlanData::Outer, polyline);
 }
-
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetAverageNormal(double normal[3]) const
@@ -1831,17 +1838,11 @@ vtkIdType vtkVolumeCutResectionPlanner::GetNumberOfFilledVoxels() const
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetShapeImage(vtkImageData* image) const
 {
-  if (!image)
-  {
-    return;
-  }
-  image->Initialize();
-  const PlanData* p = this->Impl->Current.get();
+  const PlanData* p = this->Impl->StartBoxImage(image);
   if (!p)
   {
     return;
   }
-  image->SetExtent(const_cast<int*>(p->Box));
   vtkNew<vtkUnsignedCharArray> classes;
   classes->SetName("Shape");
   classes->SetNumberOfTuples(p->Count);
@@ -1855,17 +1856,11 @@ void vtkVolumeCutResectionPlanner::GetShapeImage(vtkImageData* image) const
 //------------------------------------------------------------------------------
 void vtkVolumeCutResectionPlanner::GetDepthImage(vtkImageData* image) const
 {
-  if (!image)
-  {
-    return;
-  }
-  image->Initialize();
-  const PlanData* p = this->Impl->Current.get();
+  const PlanData* p = this->Impl->StartBoxImage(image);
   if (!p)
   {
     return;
   }
-  image->SetExtent(const_cast<int*>(p->Box));
   vtkNew<vtkFloatArray> depth;
   depth->SetName("Depth");
   depth->SetNumberOfTuples(p->Count);

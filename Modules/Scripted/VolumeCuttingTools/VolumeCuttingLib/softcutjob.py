@@ -14,7 +14,7 @@ Renders (through vtkMRMLVolumeCutDisplayableManager and the adaptive
 multivolume mapper; the CT's skin at -500 HU, soft tissue in skin colour,
 bone from the bone segmentation in bone colour): the outline on the skin,
 the two previews, the carved cheek, a close view of the defect, and the
-resection's mesh on its own. Everything goes into the main job's output
+resection's mesh on its own, from outside and from the deep side. Everything goes into the main job's output
 folder with the prefix ``softcut_``; ``run`` returns the summary's
 ``softcut`` section.
 """
@@ -30,7 +30,7 @@ import slicer
 import vtk
 
 from . import headct, nodes, softcut
-from .application import HeadlessSlicer
+from .application import HeadlessSlicer, _write_screenshot
 
 # The outline: an ellipse of 34 x 24 mm centred on the right cheek (RAS, mm),
 # below the eye and lateral to the nose, seen from the patient's right front.
@@ -100,16 +100,10 @@ def _outline_model(scene, planner, name):
 
 
 def _mesh_image(mesh, normal, path, size):
-    """The resection's mesh on its own (plain VTK), seen from outside the cheek, in flap colour."""
-    renderer = vtk.vtkRenderer()
-    renderer.SetBackground(0.32, 0.34, 0.43)
-    mapper = vtk.vtkPolyDataMapper()
-    mapper.SetInputData(mesh)
-    actor = vtk.vtkActor()
-    actor.SetMapper(mapper)
-    actor.GetProperty().SetColor(*SOFT_TISSUE_COLOR)
-    actor.GetProperty().SetSpecular(0.2)
-    renderer.AddActor(actor)
+    """The resection's mesh on its own (plain VTK), in flap colour: from outside (the skin) and from inside (the deep side)."""
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(True)
+    window.SetSize(*size)
     edges = vtk.vtkFeatureEdges()
     edges.SetInputData(mesh)
     edges.BoundaryEdgesOff()
@@ -117,37 +111,37 @@ def _mesh_image(mesh, normal, path, size):
     edges.SetFeatureAngle(50.0)
     edges.ManifoldEdgesOff()
     edges.NonManifoldEdgesOff()
-    edge_mapper = vtk.vtkPolyDataMapper()
-    edge_mapper.SetInputConnection(edges.GetOutputPort())
-    edge_mapper.ScalarVisibilityOff()
-    edge_actor = vtk.vtkActor()
-    edge_actor.SetMapper(edge_mapper)
-    edge_actor.GetProperty().SetColor(0.4, 0.15, 0.1)
-    renderer.AddActor(edge_actor)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(True)
-    window.SetSize(*size)
-    window.AddRenderer(renderer)
-    renderer.ResetCamera()
-    camera = renderer.GetActiveCamera()
-    center = np.array(camera.GetFocalPoint())
-    distance = camera.GetDistance()
-    # Three quarters: from outside and a little from the side and below, so the thickness shows.
-    direction = np.asarray(normal) + np.array([0.0, 0.0, -0.45])
-    direction /= np.linalg.norm(direction)
-    camera.SetPosition(*(center + distance * direction))
-    camera.SetViewUp(0.0, 0.0, 1.0)
-    renderer.ResetCamera()
+    for side, viewport in ((1.0, (0.0, 0.0, 0.5, 1.0)), (-1.0, (0.5, 0.0, 1.0, 1.0))):
+        renderer = vtk.vtkRenderer()
+        renderer.SetViewport(*viewport)
+        renderer.SetBackground(0.32, 0.34, 0.43)
+        mapper = vtk.vtkPolyDataMapper()
+        mapper.SetInputData(mesh)
+        actor = vtk.vtkActor()
+        actor.SetMapper(mapper)
+        actor.GetProperty().SetColor(*SOFT_TISSUE_COLOR)
+        actor.GetProperty().SetSpecular(0.2)
+        renderer.AddActor(actor)
+        edge_mapper = vtk.vtkPolyDataMapper()
+        edge_mapper.SetInputConnection(edges.GetOutputPort())
+        edge_mapper.ScalarVisibilityOff()
+        edge_actor = vtk.vtkActor()
+        edge_actor.SetMapper(edge_mapper)
+        edge_actor.GetProperty().SetColor(0.4, 0.15, 0.1)
+        renderer.AddActor(edge_actor)
+        window.AddRenderer(renderer)
+        renderer.ResetCamera()
+        camera = renderer.GetActiveCamera()
+        center = np.array(camera.GetFocalPoint())
+        distance = camera.GetDistance()
+        # Three quarters, a little from below, so the thickness shows.
+        direction = side * np.asarray(normal) + np.array([0.0, 0.0, -0.45])
+        direction /= np.linalg.norm(direction)
+        camera.SetPosition(*(center + distance * direction))
+        camera.SetViewUp(0.0, 0.0, 1.0)
+        renderer.ResetCamera()
     window.Render()
-    grabber = vtk.vtkWindowToImageFilter()
-    grabber.SetInput(window)
-    grabber.ReadFrontBufferOff()
-    grabber.ShouldRerenderOff()
-    grabber.Update()
-    writer = vtk.vtkPNGWriter()
-    writer.SetFileName(str(path))
-    writer.SetInputConnection(grabber.GetOutputPort())
-    writer.Write()
+    _write_screenshot(window, path)
     window.Finalize()
     return path
 
