@@ -871,6 +871,12 @@ bool vtkSlicerVolumeCuttingLogic::RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode
 }
 
 //----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingLogic::CutSampledRegion(vtkMRMLVolumeCutNode* cutNode, vtkImageData* distances, vtkImageData* keep)
+{
+  return this->ApplyStroke(cutNode, [&](vtkVolumeCutField* field) { return field->CutSampledRegion(distances, keep); });
+}
+
+//----------------------------------------------------------------------------
 bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
 {
   vtkVolumeCutField* field = this->GetStrokeField(cutNode);

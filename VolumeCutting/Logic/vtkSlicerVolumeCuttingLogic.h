@@ -126,6 +126,10 @@ public:
   /// from pose0 to pose1 (tool-to-RAS).
   bool CutToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
   bool RestoreToolSweep(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
+  /// A region given as sampled signed distances on the anatomy's voxels
+  /// minus voxels kept (vtkVolumeCutField::CutSampledRegion): a planned
+  /// SoftCut resection (vtkSlicerVolumeCuttingSoftCutLogic), one undo step.
+  bool CutSampledRegion(vtkMRMLVolumeCutNode* cutNode, vtkImageData* distances, vtkImageData* keep);
   /// Drill for dt seconds with rate-based material removal (seed 003): the
   /// node's anatomy gives bone density in HU; burrType is
   /// vtkVolumeCutMaterialRemoval::CuttingBurr or DiamondBurr. Exposure

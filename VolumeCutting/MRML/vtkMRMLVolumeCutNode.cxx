@@ -108,6 +108,23 @@ void vtkMRMLVolumeCutNode::SetCutField(vtkVolumeCutField* field)
 }
 
 //----------------------------------------------------------------------------
+vtkVolumeCutField* vtkMRMLVolumeCutNode::GetPreviewCutField()
+{
+  return this->PreviewCutField;
+}
+
+//----------------------------------------------------------------------------
+void vtkMRMLVolumeCutNode::SetPreviewCutField(vtkVolumeCutField* field)
+{
+  if (field == this->PreviewCutField)
+  {
+    return;
+  }
+  this->PreviewCutField = field;
+  this->InvokeCustomModifiedEvent(CutModifiedEvent);
+}
+
+//----------------------------------------------------------------------------
 vtkMRMLStorageNode* vtkMRMLVolumeCutNode::CreateDefaultStorageNode()
 {
   return vtkMRMLVolumeCutStorageNode::New();

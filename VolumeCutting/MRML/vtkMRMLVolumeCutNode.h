@@ -13,6 +13,7 @@
 
 // MRML includes
 #include <vtkMRMLStorableNode.h>
+#include <vtkSmartPointer.h>
 
 // STD includes
 #include <string>
@@ -82,6 +83,16 @@ public:
   /// the anatomy's grid. Changes of the field mark the node modified for saving.
   vtkVolumeCutField* GetCutField() { return this->CutField; }
   void SetCutField(vtkVolumeCutField* field);
+  ///@}
+
+  ///@{
+  /// A second removed region shown in 3D views with the cut field but not
+  /// part of the cut: a preview (a SoftCut resection at the depth being
+  /// chosen, vtkSlicerVolumeCuttingSoftCutLogic). Not saved, copied or
+  /// undone with the node; nullptr (the default) for none. Setting it
+  /// invokes CutModifiedEvent.
+  vtkVolumeCutField* GetPreviewCutField();
+  void SetPreviewCutField(vtkVolumeCutField* field);
   ///@}
 
   vtkMRMLStorageNode* CreateDefaultStorageNode() override;
@@ -195,6 +206,7 @@ protected:
   static const char* ActiveToolReferenceRole;
 
   vtkVolumeCutField* CutField{ nullptr };
+  vtkSmartPointer<vtkVolumeCutField> PreviewCutField;
   std::vector<std::string> CuttableSegmentIDs;
   std::vector<std::string> ProtectedSegmentIDs;
   int SubVoxelFactor{ 2 };

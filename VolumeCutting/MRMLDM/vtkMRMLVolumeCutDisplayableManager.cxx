@@ -45,6 +45,7 @@ struct vtkMRMLVolumeCutDisplayableManager::Internals
     vtkSmartPointer<vtkVolumeCutVolumeMapper> Mapper;
     vtkSmartPointer<vtkImageData> Labels;
     vtkVolumeCutField* Field = nullptr;
+    vtkVolumeCutField* PreviewField = nullptr;
     std::string LabelSource;
     std::string FractionSource;
   };
@@ -173,9 +174,10 @@ void vtkMRMLVolumeCutDisplayableManager::ProcessMRMLNodesEvents(vtkObject* calle
   }
   else
   {
-    // The cut field may have been created by this stroke.
+    // The cut field may have been created by this stroke, a preview set or cleared.
     auto found = this->Impl->Pipelines.find(cutNode);
-    if (found == this->Impl->Pipelines.end() || found->second.Field != cutNode->GetCutField())
+    if (found == this->Impl->Pipelines.end() || found->second.Field != cutNode->GetCutField() ||
+      found->second.PreviewField != cutNode->GetPreviewCutField())
     {
       this->UpdatePipeline(cutNode);
     }
@@ -225,14 +227,19 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
   {
     pipeline.Volume->SetUserMatrix(ijkToRas);
   }
-  if (pipeline.Field != node->GetCutField())
+  if (pipeline.Field != node->GetCutField() || pipeline.PreviewField != node->GetPreviewCutField())
   {
+    // A preview is one more removed region, through the multi-field path.
     caster->RemoveAllCutFields();
-    if (node->GetCutField())
+    for (vtkVolumeCutField* field : { node->GetCutField(), node->GetPreviewCutField() })
     {
-      caster->AddCutField(node->GetCutField());
+      if (field)
+      {
+        caster->AddCutField(field);
+      }
     }
     pipeline.Field = node->GetCutField();
+    pipeline.PreviewField = node->GetPreviewCutField();
   }
   caster->SetIsoValue(node->GetSurfaceIsoValue());
   caster->SetThinBoneShading(node->GetThinBoneShading());

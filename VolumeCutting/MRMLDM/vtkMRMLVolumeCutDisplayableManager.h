@@ -10,11 +10,11 @@
  * @brief   Shows each volume-cut node in 3D views through vtkVolumeCutVolumeMapper.
  *
  * For every vtkMRMLVolumeCutNode of the scene, one vtkVolume renders the
- * node's anatomy volume (placed by its IJK-to-RAS) minus the node's cut field,
- * with exact cut surfaces and edges. When the node has a segmentation, its
- * segments visible in 3D (per-segment 3D visibility) are drawn in their
- * colours and per-segment 3D opacities: cuttable segments by the CT surface
- * (the node's SurfaceIsoValue) inside them, other segments by their own
+ * node's anatomy volume (placed by its IJK-to-RAS) minus the node's cut field
+ * and its preview field if it has one, with exact cut surfaces and edges.
+ * When the node has a segmentation, its segments visible in 3D (per-segment
+ * 3D visibility) are drawn in their colours and per-segment 3D opacities:
+ * cuttable segments by the CT surface (the node's SurfaceIsoValue) inside them, other segments by their own
  * shape. The segmentation's own 3D surfaces are independent: hide them
  * (display node Visibility3D) to see the cut anatomy alone. Thin-bone shading
  * follows the node.

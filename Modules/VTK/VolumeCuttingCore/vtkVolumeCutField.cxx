@@ -6,6 +6,7 @@
 #include "vtkVolumeCutKernels.h"
 #include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutProtectionBrick.h"
+#include "vtkVolumeCutSampledRegionSource.h"
 #include "vtkVolumeCutSweepSources.h"
 
 #include "vtkDataArray.h"
@@ -563,6 +564,123 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
   std::vector<vtkVolumeCutSweeps::RigidPose> poses = vtkVolumeCutSweeps::InterpolatePoses(start, end, tool->GetBoundingRadius(), step);
   const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
   this->ApplyDistance(source, operation);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* keep)
+{
+  if (!this->Directory)
+  {
+    vtkErrorMacro("CutSampledRegion: the cut field is not initialized");
+    return false;
+  }
+  vtkDataArray* values = distances ? distances->GetPointData()->GetScalars() : nullptr;
+  if (!values || (values->GetDataType() != VTK_FLOAT && values->GetDataType() != VTK_DOUBLE) || values->GetNumberOfTuples() == 0)
+  {
+    vtkErrorMacro("CutSampledRegion: the distances need float or double scalars; nothing was cut");
+    return false;
+  }
+  vtkDataArray* keepValues = keep ? keep->GetPointData()->GetScalars() : nullptr;
+  if (keep && (!keepValues || !keepValues->IsIntegral() || keepValues->GetNumberOfComponents() != 1))
+  {
+    vtkErrorMacro("CutSampledRegion: the voxels to keep need one integer scalar component; nothing was cut");
+    return false;
+  }
+  const int components = values->GetNumberOfComponents();
+  std::vector<float> converted;
+  const float* samples = nullptr;
+  if (values->GetDataType() == VTK_FLOAT)
+  {
+    samples = static_cast<const float*>(values->GetVoidPointer(0));
+  }
+  else
+  {
+    converted.resize(static_cast<size_t>(values->GetNumberOfValues()));
+    const double* source = static_cast<const double*>(values->GetVoidPointer(0));
+    std::transform(source, source + converted.size(), converted.begin(), [](double v) { return static_cast<float>(v); });
+    samples = converted.data();
+  }
+  const int f = this->SubVoxelFactor;
+  double spacing[3];
+  this->GetSubVoxelSpacing(spacing);
+  vtkSmartPointer<vtkVolumeCutProtection> keepOut;
+  std::vector<char> keepBricks;
+  if (keep)
+  {
+    // The keep-out set is a shield of its own, built where the region reaches.
+    const int anatomyDimensions[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
+    const double anatomySpacing[3] = { spacing[0] * f, spacing[1] * f, spacing[2] * f };
+    keepOut = vtkSmartPointer<vtkVolumeCutProtection>::New();
+    keepOut->SetFieldGeometry(anatomyDimensions, f, anatomySpacing, this->BandWidth, this->Quantum);
+    const int image = keepOut->AddLabelImage(keep);
+    double range[2];
+    keepValues->GetRange(range, 0);
+    const int largest = static_cast<int>(std::min<double>(range[1], vtkVolumeCutProtection::MaximumLabelValue));
+    for (int value = 1; value <= largest; ++value)
+    {
+      keepOut->SetShieldLabel(image, value, 1);
+    }
+    // The bricks a kept voxel's cube comes within the band of: only those
+    // need the keep-out shield built (most of a region has none).
+    const int* extent = keep->GetExtent();
+    keepBricks.assign(static_cast<size_t>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2], 0);
+    int reach[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      reach[axis] = static_cast<int>(std::ceil(this->BandWidth / anatomySpacing[axis])) + 1;
+    }
+    vtkIdType id = 0;
+    for (int k = extent[4]; k <= extent[5]; ++k)
+    {
+      for (int j = extent[2]; j <= extent[3]; ++j)
+      {
+        for (int i = extent[0]; i <= extent[1]; ++i, ++id)
+        {
+          if (!(keepValues->GetComponent(id, 0) > 0.0))
+          {
+            continue;
+          }
+          const int voxel[3] = { i, j, k };
+          int lower[3];
+          int upper[3];
+          for (int axis = 0; axis < 3; ++axis)
+          {
+            lower[axis] = std::max(0, (voxel[axis] - reach[axis]) * f / BrickSize);
+            upper[axis] = std::min(this->BrickDimensions[axis] - 1, ((voxel[axis] + reach[axis] + 1) * f - 1) / BrickSize);
+          }
+          for (int bk = lower[2]; bk <= upper[2]; ++bk)
+          {
+            for (int bj = lower[1]; bj <= upper[1]; ++bj)
+            {
+              for (int bi = lower[0]; bi <= upper[0]; ++bi)
+              {
+                keepBricks[(static_cast<size_t>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi] = 1;
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  vtkNew<vtkMatrix4x4> ijkToRAS;
+  ijkToRAS->DeepCopy(this->AnatomyIJKToRAS);
+  vtkNew<vtkMatrix4x4> rasToIJK;
+  vtkMatrix4x4::Invert(ijkToRAS, rasToIJK);
+  double ijkToRASRows[4][4];
+  double rasToIJKRows[4][4];
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      ijkToRASRows[row][column] = ijkToRAS->GetElement(row, column);
+      rasToIJKRows[row][column] = rasToIJK->GetElement(row, column);
+    }
+  }
+  const vtkVolumeCutSweeps::SampledRegionSource source(samples, components, distances->GetExtent(), rasToIJKRows, ijkToRASRows, this->BandWidth,
+    keepOut, this->RASToSubIJK, this->BrickDimensions, this->Quantum, 0.5 * std::max({ spacing[0], spacing[1], spacing[2] }), keepBricks);
+  this->ApplyDistance(source, Operation::Cut);
+  this->LastCapsule.Valid = false;
   return true;
 }
 

@@ -154,6 +154,25 @@ public:
   /// Put back removed material inside the tool's sweep (as CutToolSweep).
   bool RestoreToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1);
 
+  /**
+   * Remove a region given as signed distances (mm, negative inside) sampled
+   * at the anatomy's voxel centres, such as a planned soft-tissue resection
+   * (vtkVolumeCutResectionPlanner). distances: a float or double image whose
+   * extent names the anatomy voxels it covers (as the shield's label images:
+   * origin, spacing and direction are not read); with several components the
+   * region is where all of them are negative, and the distance at a point is
+   * the largest of the trilinearly interpolated components, so the crease
+   * where two of them meet stays sharp. Nothing is removed outside the image.
+   * keep, if given: an integer image on the anatomy's voxels (any extent)
+   * whose positive voxels are never removed: the region stays half a
+   * sub-voxel away from their cubes, so that not even the partial-volume
+   * fraction of its surface (GetRemovedFraction) reaches them. The field's own shield applies as for any tool, contacts
+   * included. Returns false and logs an error, changing nothing, for a field
+   * that is not initialized or images without usable scalars. One undo step
+   * outside a stroke.
+   */
+  bool CutSampledRegion(vtkImageData* distances, vtkImageData* keep = nullptr);
+
   ///@{
   /**
    * Group the cuts and restores between BeginStroke and EndStroke into one

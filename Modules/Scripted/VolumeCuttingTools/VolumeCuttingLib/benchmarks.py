@@ -500,12 +500,19 @@ def workflow(repeats: int) -> list[dict]:
     return workflowbenchmarks.workflow(repeats)
 
 
+def softcut(repeats: int) -> list[dict]:
+    from . import softcutbenchmarks
+
+    return softcutbenchmarks.softcut_area(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
     "workflow": workflow,
     "sliceview": sliceview,
+    "softcut": softcut,
 }
 
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import slicer
 
-from . import drilling, headct, owndata, phantom, recording, selftests, toolconfig
+from . import drilling, headct, owndata, phantom, recording, selftests, softcutjob, toolconfig
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -342,6 +342,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         "image_slice_view": str(slice_path),
         "timings": timer.seconds,
     }
+    # Soft-tissue resection planning (SoftCut) on the head CT, in its own scene.
+    summary["softcut"] = softcutjob.run(out_dir, size=size, head_ct=not use_phantom and own_data is None)
     if own_data is not None:
         segmentation_of_roles = roles_segmentation.GetSegmentation()
         summary["own_data"] = {
