@@ -69,6 +69,8 @@ bool vtkHapticDevice::OpenAndStart()
   internal.LostReason[0] = '\0';
   const ForceValue zero = { { 0.0, 0.0, 0.0 } };
   internal.Commanded.Store(zero);
+  // No sample from before: a reconnected device starts without one.
+  this->PublishAbsence();
   // The state says Connected before the backend's thread starts, so that a
   // loss it reports at once is not overwritten.
   internal.State.store(Connected, std::memory_order_release);
@@ -140,7 +142,7 @@ bool vtkHapticDevice::GetLatestSample(Sample& sample) const
 bool vtkHapticDevice::GetLatestPosition(double position[3]) const
 {
   Sample sample;
-  if (!this->GetLatestSample(sample))
+  if (!this->GetLatestSample(sample) || !sample.Present)
   {
     return false;
   }
@@ -152,7 +154,7 @@ bool vtkHapticDevice::GetLatestPosition(double position[3]) const
 bool vtkHapticDevice::GetLatestOrientation(double orientation[4]) const
 {
   Sample sample;
-  if (!this->GetLatestSample(sample))
+  if (!this->GetLatestSample(sample) || !sample.Present)
   {
     return false;
   }
@@ -164,7 +166,7 @@ bool vtkHapticDevice::GetLatestOrientation(double orientation[4]) const
 unsigned int vtkHapticDevice::GetLatestButtons() const
 {
   Sample sample;
-  return this->GetLatestSample(sample) ? sample.Buttons : 0u;
+  return this->GetLatestSample(sample) && sample.Present ? sample.Buttons : 0u;
 }
 
 //------------------------------------------------------------------------------
@@ -286,6 +288,16 @@ void vtkHapticDevice::PublishSample(const double position[3], const double orien
   sample.Index = internal.SampleCount.load(std::memory_order_relaxed) + 1;
   internal.Latest.Store(sample);
   internal.SampleCount.store(sample.Index, std::memory_order_release);
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticDevice::PublishAbsence()
+{
+  Sample sample;
+  this->Internal->Latest.Load(sample);
+  sample.Present = false;
+  sample.Time = this->GetTimeSinceOpen();
+  this->Internal->Latest.Store(sample);
 }
 
 //------------------------------------------------------------------------------

@@ -98,12 +98,16 @@ public:
     double Time = 0.0;
     /// 1 for the first sample after Open, then counting.
     unsigned long long Index = 0;
+    /// False when the device said that nobody holds it or that it is
+    /// absent for now (a recorded disconnection being replayed).
+    bool Present = true;
   };
 
   /**
    * The latest sample, from any thread, without waiting. False if there is
    * none since the device was opened, or if the publishing thread was caught
-   * half-way too often (then keep the previous sample).
+   * half-way too often (then keep the previous sample). A sample whose
+   * Present is false says the device has no pose for now.
    */
   bool GetLatestSample(Sample& sample) const;
 #endif
@@ -203,6 +207,9 @@ protected:
 
   /// For backends, their I/O thread: a new sample (a non-finite one is rejected and counted).
   void PublishSample(const double position[3], const double orientation[4], unsigned int buttons);
+
+  /// For backends, their I/O thread: no sample for now (the last one's pose, marked absent).
+  void PublishAbsence();
 
   /// For backends, their I/O thread: the device is gone or silent. The force is dropped.
   void ReportLost(const char* reason);

@@ -577,8 +577,9 @@ void vtkHapticLoop::Tick(double timeStep)
 
   vtkHapticDevice::Sample sample;
   const bool connected = device->IsConnected();
-  bool present = connected && device->GetLatestSample(sample);
-  if (connected && !present && internal.HaveSample)
+  const bool read = connected && device->GetLatestSample(sample);
+  bool present = read && sample.Present;
+  if (connected && !read && internal.HaveSample)
   {
     // The device's thread was caught publishing: this tick uses the last sample.
     sample = internal.PreviousSample;
@@ -638,7 +639,7 @@ void vtkHapticLoop::Tick(double timeStep)
   if (internal.Switch && internal.Switch->IsConnected())
   {
     vtkHapticDevice::Sample pedal;
-    if (internal.Switch->GetLatestSample(pedal))
+    if (internal.Switch->GetLatestSample(pedal) && pedal.Present)
     {
       switchButtons = pedal.Buttons;
     }

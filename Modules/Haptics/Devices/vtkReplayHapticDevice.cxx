@@ -115,7 +115,7 @@ void vtkReplayHapticDevice::Synchronize(unsigned long long)
   }
   else
   {
-    this->PublishSample(this->LastPosition, this->LastOrientation, 0u);
+    this->PublishAbsence();
   }
   this->Cursor.store(cursor + 1, std::memory_order_release);
 }

@@ -10,9 +10,9 @@
  * not depend on timing: the same recording through the same loop and scene
  * gives the same forces and the same cut, bit for bit. The capabilities are
  * the recorded device's, so forces are limited as they were. Ticks recorded
- * while the device was absent replay as the last pose with every button
- * released (the drill stops there). After the last tick the last pose is
- * held with the buttons released and IsFinished() is true.
+ * while the device was absent (unplugged, silent) replay as absent samples,
+ * so the loop stops and resumes the drill where it did. After the last tick
+ * the last pose is held with the buttons released and IsFinished() is true.
  *
  * @sa vtkHapticRecorder vtkHapticLoop
  */
