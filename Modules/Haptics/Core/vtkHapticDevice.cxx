@@ -40,7 +40,8 @@ struct vtkHapticDevice::Internals
   // Written once by the I/O thread before it publishes State = Lost.
   char LostReason[256] = { 0 };
   std::string ErrorMessage;
-  Clock::time_point OpenTime = Clock::now();
+  /// When the device was last opened (steady clock ticks): read by publishers.
+  std::atomic<Clock::rep> OpenTime{ Clock::now().time_since_epoch().count() };
   Clock::time_point LastAttempt = Clock::now();
 };
 
@@ -64,7 +65,7 @@ bool vtkHapticDevice::OpenAndStart()
 {
   Internals& internal = *this->Internal;
   internal.LastAttempt = Clock::now();
-  internal.OpenTime = internal.LastAttempt;
+  internal.OpenTime.store(internal.LastAttempt.time_since_epoch().count(), std::memory_order_release);
   internal.SampleCount.store(0, std::memory_order_relaxed);
   internal.LostReason[0] = '\0';
   const ForceValue zero = { { 0.0, 0.0, 0.0 } };
@@ -324,7 +325,8 @@ void vtkHapticDevice::ReportRejectedInput()
 //------------------------------------------------------------------------------
 double vtkHapticDevice::GetTimeSinceOpen() const
 {
-  return std::chrono::duration<double>(Clock::now() - this->Internal->OpenTime).count();
+  const Clock::time_point opened{ Clock::duration(this->Internal->OpenTime.load(std::memory_order_acquire)) };
+  return std::chrono::duration<double>(Clock::now() - opened).count();
 }
 
 //------------------------------------------------------------------------------

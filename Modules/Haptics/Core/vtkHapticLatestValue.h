@@ -12,7 +12,7 @@
 
 /**
  * A sequence lock over a small trivially copyable value: one writer stores,
- * any number of readers load. The writer never waits. A reader retries while
+ * any number of readers load. The writer does not wait for readers. A reader retries while
  * a store overlaps its copy, at most maximumAttempts times, and then gives up
  * (returns false): a haptic thread must not spin on a writer that the
  * scheduler has paused half-way. The value is kept in atomic words so that
@@ -24,13 +24,22 @@ class vtkHapticLatestValue
   static_assert(std::is_trivially_copyable<T>::value, "vtkHapticLatestValue holds plain data only");
 
 public:
-  /// Single writer.
+  /// Writers: normally one; two that overlap (a device reopened by the main
+  /// thread while its publisher still runs) take turns.
   void Store(const T& value)
   {
     std::uint64_t words[WordCount] = {};
     std::memcpy(words, &value, sizeof(T));
-    const std::uint64_t sequence = this->Sequence.load(std::memory_order_relaxed);
-    this->Sequence.store(sequence + 1, std::memory_order_relaxed);
+    std::uint64_t sequence = this->Sequence.load(std::memory_order_relaxed);
+    for (;;)
+    {
+      if (!(sequence & 1u) &&
+        this->Sequence.compare_exchange_weak(sequence, sequence + 1, std::memory_order_acquire, std::memory_order_relaxed))
+      {
+        break;
+      }
+      sequence = this->Sequence.load(std::memory_order_relaxed);
+    }
     std::atomic_thread_fence(std::memory_order_release);
     for (int n = 0; n < WordCount; ++n)
     {
