@@ -37,6 +37,27 @@ double vtkVolumeCutCylinderTool::GetBoundingRadius()
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutCylinderTool::IsLeftBehind(const double center[3], double radius, const double motion[3])
+{
+  // Every (sub)gradient of the distance is a radial unit vector times
+  // alpha >= 0 plus the axis times sign(z) times beta >= 0. The ball is left
+  // behind if, for each term, the ball is behind the motion or the term is
+  // zero throughout it.
+  const double halfLength = 0.5 * this->Length;
+  const double radialMotion = std::sqrt(motion[0] * motion[0] + motion[1] * motion[1]);
+  const double radialCenter = std::sqrt(center[0] * center[0] + center[1] * center[1]);
+  // Radial term: x . motion <= 0 over the ball, or the ball is so near the
+  // axis of a wide cylinder (a disk) that the faces are always nearer.
+  const bool radial = radialMotion == 0.0 || center[0] * motion[0] + center[1] * motion[1] + radius * radialMotion <= 0.0 ||
+    radialCenter + radius < this->Radius - halfLength;
+  // Axial term: sign(z) motion_z <= 0 over the ball, or the ball is so far
+  // from the ends of a long cylinder that the side is always nearer.
+  const bool axial = motion[2] == 0.0 || (motion[2] > 0.0 ? center[2] + radius <= 0.0 : center[2] - radius >= 0.0) ||
+    std::abs(center[2]) + radius < halfLength - this->Radius;
+  return radial && axial;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutCylinderTool::IsValid()
 {
   if (!(this->Radius > 0.0) || !(this->Length > 0.0) || !std::isfinite(this->Radius) || !std::isfinite(this->Length))

@@ -40,6 +40,17 @@ public:
   /// Radius (mm) of a sphere about the local origin that holds the tool.
   virtual double GetBoundingRadius() = 0;
 
+  /**
+   * Whether the ball of the given radius about center (tool frame, mm) is
+   * left behind when the tool translates by any positive multiple of motion
+   * (tool frame): the tool's distance gets no smaller anywhere in the ball,
+   * because the distance's gradient there has no component along motion. A
+   * sweep continuing the previous one, which already cut the first pose,
+   * need not compute such regions again. The default, false (not known), is
+   * always safe; convex tools with a closed form answer from their geometry.
+   */
+  virtual bool IsLeftBehind(const double center[3], double radius, const double motion[3]);
+
   /// Whether the tool can cut: finite, positive sizes (and a closed surface for
   /// meshes). Logs an error saying what is wrong otherwise.
   virtual bool IsValid() = 0;
