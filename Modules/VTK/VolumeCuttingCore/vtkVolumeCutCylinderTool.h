@@ -35,6 +35,8 @@ public:
   double GetBoundingRadius() override;
   bool IsValid() override;
   bool IsLeftBehind(const double center[3], double radius, const double motion[3]) override;
+  VTK_WRAPEXCLUDE bool EvaluateTranslatedDistances(
+    const double motion[3], double step, const float* x, const float* y, const float* z, int count, float* distances) override;
 
 protected:
   vtkVolumeCutCylinderTool() = default;

@@ -520,7 +520,7 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
   const bool translation = std::equal(&start.Rotation[0][0], &start.Rotation[0][0] + 9, &end.Rotation[0][0]);
   const double motion[3] = { end.Translation[0] - start.Translation[0], end.Translation[1] - start.Translation[1],
     end.Translation[2] - start.Translation[2] };
-  const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), this->BandWidth, continued, translation ? motion : nullptr);
+  const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), this->BandWidth, step, continued, translation ? motion : nullptr);
   this->ApplyDistance(source, operation);
   this->LastToolSweep.Valid = operation == Operation::Cut;
   this->LastToolSweep.Tool = tool;

@@ -198,14 +198,16 @@ void CapsuleSource::BrickDistances(const double origin[3], const double* /*cente
 }
 
 //------------------------------------------------------------------------------
-SweptToolSource::SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, bool startCovered, const double* motion)
+SweptToolSource::SweptToolSource(
+  vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, double step, bool startCovered, const double* motion)
   : Tool(tool)
   , Poses(std::move(poses))
   , Band(band)
   , Reach(tool->GetBoundingRadius() + band)
   , FirstCopy(startCovered && this->Poses.size() > 1 ? 1 : 0)
+  , Step(step)
 {
-  if (startCovered && motion && !this->Poses.empty())
+  if (motion && !this->Poses.empty())
   {
     // The motion in the first copy's frame.
     const RigidPose& first = this->Poses.front();
@@ -213,7 +215,12 @@ SweptToolSource::SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> 
     {
       this->Motion[row] = first.Rotation[0][row] * motion[0] + first.Rotation[1][row] * motion[1] + first.Rotation[2][row] * motion[2];
     }
-    this->UseMotion = true;
+    this->Translation = true;
+    this->UseMotion = startCovered;
+    // Whether the tool has a closed form for its translated sweep (asked at one point).
+    const float origin = 0.0f;
+    float distance = 0.0f;
+    this->ClosedForm = tool->EvaluateTranslatedDistances(this->Motion, step, &origin, &origin, &origin, 1, &distance);
   }
   this->Meeting.assign(this->Poses.size(), 0);
 }
@@ -254,9 +261,24 @@ const std::vector<char>& SweptToolSource::Copies(const double center[3], double 
       }
       behind = this->Tool->IsLeftBehind(local, radius, this->Motion);
     }
-    for (size_t n = this->FirstCopy; n < this->Poses.size() && !behind; ++n)
+    if (this->ClosedForm && !behind)
     {
-      this->Meeting[n] = this->Meets(this->Poses[n], center, radius) ? 1 : 0;
+      // Every point of a translated sweep is within half the motion of the
+      // first or the last copy: those two bound the whole sweep's reach (the
+      // copies of the closed form's path need no test of their own).
+      const double halfMotion = 0.5 * std::sqrt(this->Motion[0] * this->Motion[0] + this->Motion[1] * this->Motion[1] + this->Motion[2] * this->Motion[2]);
+      const bool reaches = this->Meets(this->Poses.front(), center, radius + halfMotion) || this->Meets(this->Poses.back(), center, radius + halfMotion);
+      for (size_t n = this->FirstCopy; n < this->Poses.size(); ++n)
+      {
+        this->Meeting[n] = reaches ? 1 : 0;
+      }
+    }
+    else
+    {
+      for (size_t n = this->FirstCopy; n < this->Poses.size() && !behind; ++n)
+      {
+        this->Meeting[n] = this->Meets(this->Poses[n], center, radius) ? 1 : 0;
+      }
     }
   }
   return this->Meeting;
@@ -273,9 +295,16 @@ bool SweptToolSource::MayReach(const double center[3], double radius) const
 void SweptToolSource::BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const
 {
   // Beyond the band: clamped to Outside, so a copy out of reach changes nothing.
+  float local[3][SamplesPerBrick];
+  if (this->ClosedForm)
+  {
+    // One evaluation of the whole translated sweep.
+    ToToolFrame(this->Poses.front(), origin, offsets, local);
+    this->Tool->EvaluateTranslatedDistances(this->Motion, this->Step, local[0], local[1], local[2], SamplesPerBrick, distances);
+    return;
+  }
   const float far = static_cast<float>(this->Reach);
   std::fill(distances, distances + SamplesPerBrick, far);
-  float local[3][SamplesPerBrick];
   float copy[SamplesPerBrick];
   const std::vector<char>& meeting = this->Copies(center, radius);
   for (size_t n = 0; n < this->Poses.size(); ++n)

@@ -65,16 +65,19 @@ private:
 /// tool's own distance at the brick's centre says so) is evaluated at all its
 /// samples in one batch (vtkVolumeCutTool::EvaluateDistances).
 ///
-/// A sweep that continues the previous one (startCovered: the field holds
-/// the copy at the first pose already) skips that copy; if it is moreover a
-/// pure translation (motion, RAS), it skips every brick the tool leaves
-/// behind (vtkVolumeCutTool::IsLeftBehind): there no copy is nearer than the
-/// first one, which the field holds. A tool moving along its path therefore
-/// costs the bricks ahead of it, not all it touches.
+/// A pure translation (motion, RAS; nullptr otherwise) of a tool with a
+/// closed form for its translated sweep is evaluated once per brick instead
+/// of once per copy (vtkVolumeCutTool::EvaluateTranslatedDistances, within
+/// step of the exact sweep). A sweep that continues the previous one
+/// (startCovered: the field holds the copy at the first pose already) skips
+/// that copy; a continuing translation moreover skips every brick the tool
+/// leaves behind (vtkVolumeCutTool::IsLeftBehind): there no copy is nearer
+/// than the first one, which the field holds. A tool moving along its path
+/// therefore costs the bricks ahead of it, not all it touches.
 class SweptToolSource : public vtkVolumeCutField::BrickDistanceSource
 {
 public:
-  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, bool startCovered, const double* motion);
+  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, double step, bool startCovered, const double* motion);
   void GetReachBounds(double lower[3], double upper[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
   void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override;
@@ -91,6 +94,9 @@ private:
   double Band;
   double Reach;
   size_t FirstCopy;
+  double Step;
+  bool Translation = false;
+  bool ClosedForm = false;
   bool UseMotion = false;
   double Motion[3] = { 0.0, 0.0, 0.0 };
   mutable std::vector<char> Meeting;

@@ -23,3 +23,9 @@ bool vtkVolumeCutTool::IsLeftBehind(const double*, double, const double*)
 {
   return false;
 }
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutTool::EvaluateTranslatedDistances(const double*, double, const float*, const float*, const float*, int, float*)
+{
+  return false;
+}
