@@ -58,6 +58,7 @@ struct Display
   double ToolToRAS[16];
   double Force[3];
   int Drilling;
+  double ContactDepth;
 };
 
 /// A hint to the processor inside a wait loop.
@@ -391,7 +392,7 @@ bool vtkHapticLoop::Prepare()
   internal.NeedsReset = true;
   internal.StrokeOpen = false;
   internal.LastCutValid = false;
-  this->NumberOfCutStrokes = this->NumberOfDrillPresses = this->NumberOfDeviceLosses = 0;
+  this->NumberOfCutStrokes = this->NumberOfDrillPresses = this->NumberOfDrillReleases = this->NumberOfDeviceLosses = 0;
   this->NumberOfDeviceReturns = this->NumberOfFailedCuts = this->NumberOfDroppedEvents = 0;
   internal.DroppedEvents = 0;
   Event stale;
@@ -727,6 +728,7 @@ void vtkHapticLoop::Tick(double timeStep)
   display.ToolToRAS[15] = 1.0;
   std::copy(sent, sent + 3, display.Force);
   display.Drilling = drilling ? 1 : 0;
+  display.ContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
   internal.Latest.Store(display);
 
   if (internal.Recorder)
@@ -772,6 +774,14 @@ bool vtkHapticLoop::GetDrilling() const
 }
 
 //------------------------------------------------------------------------------
+double vtkHapticLoop::GetLatestContactDepth() const
+{
+  Display display{};
+  this->Internal->Latest.Load(display);
+  return display.ContactDepth;
+}
+
+//------------------------------------------------------------------------------
 int vtkHapticLoop::ProcessEvents()
 {
   Internals& internal = *this->Internal;
@@ -788,6 +798,9 @@ int vtkHapticLoop::ProcessEvents()
         break;
       case DrillPressEvent:
         ++this->NumberOfDrillPresses;
+        break;
+      case DrillReleaseEvent:
+        ++this->NumberOfDrillReleases;
         break;
       case LostEvent:
         ++this->NumberOfDeviceLosses;

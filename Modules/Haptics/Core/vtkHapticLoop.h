@@ -174,6 +174,13 @@ public:
   ///@}
 
   /**
+   * The cut field's deepest contact with a protected structure (mm) as the
+   * haptic thread last read it, after its cuts: the main thread must not
+   * read the field's contact record while the loop writes it.
+   */
+  double GetLatestContactDepth() const;
+
+  /**
    * Drain what the haptic thread reported since the last call (cut strokes,
    * drill presses and releases, device losses and returns, failed cuts) into
    * the counters below; returns the number of cut strokes among them. Main thread.
@@ -186,6 +193,7 @@ public:
    */
   vtkGetMacro(NumberOfCutStrokes, int);
   vtkGetMacro(NumberOfDrillPresses, int);
+  vtkGetMacro(NumberOfDrillReleases, int);
   vtkGetMacro(NumberOfDeviceLosses, int);
   vtkGetMacro(NumberOfDeviceReturns, int);
   vtkGetMacro(NumberOfFailedCuts, int);
@@ -229,6 +237,7 @@ protected:
   int StatisticsCapacity = 100000;
   int NumberOfCutStrokes = 0;
   int NumberOfDrillPresses = 0;
+  int NumberOfDrillReleases = 0;
   int NumberOfDeviceLosses = 0;
   int NumberOfDeviceReturns = 0;
   int NumberOfFailedCuts = 0;

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import slicer
 
-from . import drilling, headct, owndata, phantom
+from . import drilling, hapticsjob, headct, owndata, phantom
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -196,6 +196,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
 
     with timer.measure("drilling_s"):
         drilled = drilling.drill(logic, cut_node, plan)
+    with timer.measure("haptics_s"):
+        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
     removed_per_segment = {
         segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
         for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
@@ -272,6 +274,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
                 "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
             },
         },
+        "haptics": haptics,
         "exports": {
             "removed_segmentation": removed.GetName(),
             "removed_fraction_volume": removed_fraction.GetName(),
