@@ -67,7 +67,8 @@ int vtkHapticForceModelTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   double force[3];
   const double pressed[3] = { 0.7, -1.1, scene.PlaneHeight + radius - 0.05 };
   CHECK_INT(model->ComputeContactForce(pressed, force), 1);
-  CHECK_DOUBLE_TOLERANCE(force[2], model->GetContactStiffness() * 0.05, 1e-6);
+  // The exit is found to 1/256 of a trace step (half a voxel).
+  CHECK_DOUBLE_TOLERANCE(force[2], model->GetContactStiffness() * 0.05, model->GetContactStiffness() * scene.Spacing / 256.0);
   CHECK_DOUBLE_TOLERANCE(force[0], 0.0, 1e-9);
   CHECK_DOUBLE_TOLERANCE(force[1], 0.0, 1e-9);
 

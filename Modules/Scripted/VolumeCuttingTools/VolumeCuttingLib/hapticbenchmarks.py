@@ -171,7 +171,7 @@ def _contact_ratio(cut_node, out_dir, machine) -> list[dict]:
         f"contact of the burr's 82 shell points against the CT iso-surface minus the cut field, "
         f"at the {len(positions)} drilling proxy positions of the replay ({contacts // 3} in contact), from Python: p{q}",
         sub[q], "us", "whole-voxel contact test of the same points (nearest voxel, whole-voxel removal), same calls",
-        whole[q], len(sub_voxel), machine) for q in (50, 99)], whole
+        whole[q], len(sub_voxel), machine) for q in (50, 99)], whole_voxel
 
 
 def _first_call(cut_node, position) -> float:
