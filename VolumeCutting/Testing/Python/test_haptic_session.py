@@ -16,29 +16,13 @@ import pytest
 import slicer
 import vtk
 
+from test_session_persistence import VtkMessages
 from VolumeCuttingLib import hapticsjob, nodes, toolconfig
 from VolumeCuttingLib.application import HeadlessSlicer
 
 SHAPE = (30, 48, 48)  # k, j, i
 SPACING = (0.5, 0.5, 0.8)
 DISPLAY_PERIOD_S = 1.0 / 60.0
-
-
-class VtkMessages:
-    """Collects what VTK logs (errors and warnings)."""
-
-    def __enter__(self):
-        self.window = vtk.vtkStringOutputWindow()
-        self.previous = vtk.vtkOutputWindow.GetInstance()
-        vtk.vtkOutputWindow.SetInstance(self.window)
-        return self
-
-    def __exit__(self, *exc):
-        vtk.vtkOutputWindow.SetInstance(self.previous)
-
-    @property
-    def text(self):
-        return self.window.GetOutput()
 
 
 def block_scene():

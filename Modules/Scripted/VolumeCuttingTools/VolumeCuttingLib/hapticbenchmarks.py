@@ -139,16 +139,12 @@ def _replay(application, cut_node, plan, out_dir, frame):
 
 def _contact_ratio(cut_node, out_dir, machine) -> list[dict]:
     """Sub-voxel contact (82 points) against whole-voxel contact at the replay's proxy positions, same calls."""
+    model = hapticsjob.force_model(cut_node, sphere_radius=2.0)
+    if model is None:
+        raise RuntimeError("the force model could not be prepared (see the log)")
     anatomy = cut_node.GetAnatomyVolumeNode()
     ijk_to_ras = vtk.vtkMatrix4x4()
     anatomy.GetIJKToRASMatrix(ijk_to_ras)
-    model = slicer.vtkHapticForceModel()
-    model.SetAnatomy(anatomy.GetImageData(), ijk_to_ras)
-    model.SetSurfaceIsoValue(cut_node.GetSurfaceIsoValue())
-    model.SetCutField(cut_node.GetCutField())
-    model.SetSphereRadius(2.0)
-    if not model.Prepare():
-        raise RuntimeError("the force model could not be prepared (see the log)")
     cutter = slicer.vtkBinaryVoxelCutter()
     cutter.Initialize(list(anatomy.GetImageData().GetDimensions()), ijk_to_ras)
     recording = slicer.vtkHapticRecorder()
@@ -183,15 +179,7 @@ def _contact_ratio(cut_node, out_dir, machine) -> list[dict]:
 
 def _first_call(cut_node, position) -> float:
     """The first force-model step after Prepare at a pose in contact, drill on (s)."""
-    anatomy = cut_node.GetAnatomyVolumeNode()
-    ijk_to_ras = vtk.vtkMatrix4x4()
-    anatomy.GetIJKToRASMatrix(ijk_to_ras)
-    model = slicer.vtkHapticForceModel()
-    model.SetAnatomy(anatomy.GetImageData(), ijk_to_ras)
-    model.SetSurfaceIsoValue(cut_node.GetSurfaceIsoValue())
-    model.SetCutField(cut_node.GetCutField())
-    model.SetSphereRadius(2.0)
-    model.Prepare()
+    model = hapticsjob.force_model(cut_node, sphere_radius=2.0)
     model.Reset([position[0] - 3.0, position[1], position[2]])
     start = time.perf_counter()
     model.Step(position, 0.001, True)

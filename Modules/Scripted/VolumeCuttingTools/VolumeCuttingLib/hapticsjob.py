@@ -38,16 +38,24 @@ RATE_HZ = 1000.0
 DISPLAY_PERIOD_S = 1.0 / 60.0
 
 
-def _first_solid(cut_node, start, direction, length=60.0, step=0.1):
-    """The first point of the line that is solid as the renderer draws it (None if none)."""
+def force_model(cut_node, sphere_radius=None):
+    """A force model on what the cut node draws (its CT's iso-surface minus its cut field), prepared; None if it cannot be."""
     anatomy = cut_node.GetAnatomyVolumeNode()
     ijk_to_ras = vtk.vtkMatrix4x4()
     anatomy.GetIJKToRASMatrix(ijk_to_ras)
-    probe = slicer.vtkHapticForceModel()
-    probe.SetAnatomy(anatomy.GetImageData(), ijk_to_ras)
-    probe.SetSurfaceIsoValue(cut_node.GetSurfaceIsoValue())
-    probe.SetCutField(cut_node.GetCutField())
-    if not probe.Prepare():
+    model = slicer.vtkHapticForceModel()
+    model.SetAnatomy(anatomy.GetImageData(), ijk_to_ras)
+    model.SetSurfaceIsoValue(cut_node.GetSurfaceIsoValue())
+    model.SetCutField(cut_node.GetCutField())
+    if sphere_radius is not None:
+        model.SetSphereRadius(sphere_radius)
+    return model if model.Prepare() else None
+
+
+def _first_solid(cut_node, start, direction, length=60.0, step=0.1):
+    """The first point of the line that is solid as the renderer draws it (None if none)."""
+    probe = force_model(cut_node)
+    if probe is None:
         return None
     for t in np.arange(0.0, length, step):
         point = start + t * direction
