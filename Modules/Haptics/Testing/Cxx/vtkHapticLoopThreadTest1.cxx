@@ -98,6 +98,8 @@ int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
     loop->GetLatestToolPose(pose);
     double force[3];
     loop->GetLatestForce(force);
+    // The contact depth as the haptic thread last read it from the field it writes.
+    CHECK_BOOL(loop->GetLatestContactDepth() >= 0.0, true);
     cuts += loop->ProcessEvents();
     device->ProcessConnectionEvents();
     if (frame == 20)
