@@ -38,16 +38,7 @@ def block_scene():
     labels = np.zeros(SHAPE, np.uint8)
     labels[ct > 0] = 1
     labels[(ct > 0) & ((j - 24) ** 2 + (k - 15) ** 2 <= 4) & (i > 30)] = 2  # "Nerve": deep in the block
-    segmentation = scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "Anatomy")
-    segmentation.SetReferenceImageGeometryParameterFromVolumeNode(volume)
-    for value, name in ((1, "Bone"), (2, "Nerve")):
-        mask = slicer.vtkOrientedImageData()
-        mask.ShallowCopy(nodes.image_data_from_array((labels == value).astype(np.uint8)))
-        mask.SetImageToWorldMatrix(nodes.numpy_to_vtk_matrix(ijk_to_ras))
-        segment = slicer.vtkSegment()
-        segment.SetName(name)
-        segment.AddRepresentation("Binary labelmap", mask)
-        segmentation.GetSegmentation().AddSegment(segment, name)
+    segmentation = nodes.create_segmentation_from_labels(scene, volume, labels, {1: "Bone", 2: "Nerve"}, "Anatomy")
     cut = logic.AddVolumeCutNode(volume, segmentation)
     cut.SetCuttableSegmentIDs(["Bone"])
     cut.SetProtectedSegmentIDs(["Nerve"])
