@@ -5,17 +5,29 @@
 # volumecutting_add_library(<kit>
 #   VTK_MODULE <name in vtk.module> EXPORT_DIRECTIVE <macro> SRCS <files...>
 #   [PRIVATE_SRCS <files...>] [INCLUDE_DIRECTORIES <dirs...>]
-#   [TARGET_LIBRARIES <libs...>])
+#   [TARGET_LIBRARIES <libs...>] [PRIVATE_LIBRARIES <targets...>])
 #
-# SRCS are classes (<class>.cxx with <class>.h), installed and wrapped.
+# SRCS are classes (<class>.cxx with <class>.h), installed and wrapped; a
+# class may live in a subfolder of the layer (<folder>/<class>.cxx), whose
+# folder is then on the include path of the library and its users.
 # PRIVATE_SRCS are compiled into the library only: no class, not wrapped.
+# PRIVATE_LIBRARIES are libraries from outside VTK and Slicer (pkg-config
+# imported targets) that the library links in both modes.
 #
 # Every library exposes <kit>Export.h defining <EXPORT_DIRECTIVE>, as Slicer's
 # macros generate it; in Core mode the header forwards to the VTK module's.
 # TARGET_LIBRARIES are used in extension mode only: in Core mode the
 # dependencies come from vtk.module.
 function(volumecutting_add_library kit)
-  cmake_parse_arguments(PARSE_ARGV 1 arg "" "VTK_MODULE;EXPORT_DIRECTIVE" "SRCS;PRIVATE_SRCS;INCLUDE_DIRECTORIES;TARGET_LIBRARIES")
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "VTK_MODULE;EXPORT_DIRECTIVE" "SRCS;PRIVATE_SRCS;INCLUDE_DIRECTORIES;TARGET_LIBRARIES;PRIVATE_LIBRARIES")
+  set(class_folders)
+  foreach(source IN LISTS arg_SRCS arg_PRIVATE_SRCS)
+    get_filename_component(folder "${source}" DIRECTORY)
+    if(folder)
+      list(APPEND class_folders "${CMAKE_CURRENT_SOURCE_DIR}/${folder}")
+    endif()
+  endforeach()
+  list(REMOVE_DUPLICATES class_folders)
   if(VolumeCutting_BUILD_WITH_SLICER_CORE)
     set(classes)
     foreach(source IN LISTS arg_SRCS)
@@ -36,15 +48,21 @@ function(volumecutting_add_library kit)
       SOURCES ${private_sources}
       PRIVATE_HEADERS ${private_headers}
       )
+    foreach(folder IN LISTS class_folders)
+      vtk_module_include(${arg_VTK_MODULE} PUBLIC "$<BUILD_INTERFACE:${folder}>")
+    endforeach()
+    if(arg_PRIVATE_LIBRARIES)
+      vtk_module_link(${arg_VTK_MODULE} PRIVATE ${arg_PRIVATE_LIBRARIES})
+    endif()
   else()
     # Slicer's wrapping takes every <name>.cxx that has a <name>.h.
     set_source_files_properties(${arg_PRIVATE_SRCS} PROPERTIES WRAP_EXCLUDE ON)
     SlicerMacroBuildModuleLogic(
       NAME ${kit}
       EXPORT_DIRECTIVE ${arg_EXPORT_DIRECTIVE}
-      INCLUDE_DIRECTORIES ${arg_INCLUDE_DIRECTORIES}
+      INCLUDE_DIRECTORIES ${arg_INCLUDE_DIRECTORIES} ${class_folders}
       SRCS ${arg_SRCS} ${arg_PRIVATE_SRCS}
-      TARGET_LIBRARIES ${arg_TARGET_LIBRARIES}
+      TARGET_LIBRARIES ${arg_TARGET_LIBRARIES} ${arg_PRIVATE_LIBRARIES}
       )
   endif()
 endfunction()

@@ -3,7 +3,7 @@
 Run by both README commands (through Utilities/vc). Each step checks first and only
 does what is missing:
 
-1. Debian bookworm packages (compiler, CMake, Ninja, hidapi, libusb, Mesa EGL);
+1. Debian bookworm packages (compiler, CMake, Ninja, hidapi, libusb, umockdev, Mesa EGL);
 2. the project virtual environment ``.venv`` with the exact wheels of
    ``requirements.lock`` (hash-checked), downloaded once into the cache;
 3. the VTK 9.6.2 SDK matching the vtk wheel, assembled from Debian sid (vtk_sdk.py);
@@ -38,6 +38,8 @@ PYTHON_VERSION = (3, 11)
 APT_PACKAGES = [
     "g++", "cmake", "ninja-build", "pkg-config",
     "libhidapi-dev", "libusb-1.0-0-dev",
+    # The device backends' tests fake USB and hidraw devices in user space.
+    "umockdev", "libumockdev-dev",
     # Offscreen rendering without a display: VTK falls back to EGL on Mesa.
     "libegl1", "libegl-mesa0", "libgl1-mesa-dri",
 ]

@@ -34,6 +34,37 @@ void vtkVolumeCutBoxTool::EvaluateDistances(const float* x, const float* y, cons
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutBoxTool::IsLeftBehind(const double center[3], double radius, const double motion[3])
+{
+  // Every (sub)gradient is a sum over the axes of the face normal sign(x_i)
+  // e_i times a weight >= 0. Each axis the motion has must either see the
+  // whole ball behind the motion, or have weight zero throughout the ball:
+  // then the ball is deeper in that slab than another face is near.
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    if (motion[axis] == 0.0)
+    {
+      continue;
+    }
+    const bool behind = motion[axis] > 0.0 ? center[axis] + radius <= 0.0 : center[axis] - radius >= 0.0;
+    double nearestOther = 1e300;
+    for (int other = 0; other < 3; ++other)
+    {
+      if (other != axis)
+      {
+        nearestOther = std::min(nearestOther, 0.5 * this->Size[other]);
+      }
+    }
+    const bool inactive = std::abs(center[axis]) + radius < 0.5 * this->Size[axis] - nearestOther;
+    if (!behind && !inactive)
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
 double vtkVolumeCutBoxTool::GetBoundingRadius()
 {
   return 0.5 * std::sqrt(this->Size[0] * this->Size[0] + this->Size[1] * this->Size[1] + this->Size[2] * this->Size[2]);

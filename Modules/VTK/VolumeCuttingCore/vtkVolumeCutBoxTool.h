@@ -32,6 +32,7 @@ public:
   VTK_WRAPEXCLUDE void EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances) override;
   double GetBoundingRadius() override;
   bool IsValid() override;
+  bool IsLeftBehind(const double center[3], double radius, const double motion[3]) override;
 
 protected:
   vtkVolumeCutBoxTool() = default;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 vtkStandardNewMacro(vtkVolumeCutCylinderTool);
 
@@ -34,6 +35,58 @@ void vtkVolumeCutCylinderTool::EvaluateDistances(const float* x, const float* y,
 double vtkVolumeCutCylinderTool::GetBoundingRadius()
 {
   return std::hypot(this->Radius, 0.5 * this->Length);
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutCylinderTool::IsLeftBehind(const double center[3], double radius, const double motion[3])
+{
+  // Every (sub)gradient of the distance is a radial unit vector times
+  // alpha >= 0 plus the axis times sign(z) times beta >= 0. The ball is left
+  // behind if, for each term, the ball is behind the motion or the term is
+  // zero throughout it.
+  const double halfLength = 0.5 * this->Length;
+  const double radialMotion = std::sqrt(motion[0] * motion[0] + motion[1] * motion[1]);
+  const double radialCenter = std::sqrt(center[0] * center[0] + center[1] * center[1]);
+  // Radial term: x . motion <= 0 over the ball, or the ball is so near the
+  // axis of a wide cylinder (a disk) that the faces are always nearer.
+  const bool radial = radialMotion == 0.0 || center[0] * motion[0] + center[1] * motion[1] + radius * radialMotion <= 0.0 ||
+    radialCenter + radius < this->Radius - halfLength;
+  // Axial term: sign(z) motion_z <= 0 over the ball, or the ball is so far
+  // from the ends of a long cylinder that the side is always nearer.
+  const bool axial = motion[2] == 0.0 || (motion[2] > 0.0 ? center[2] + radius <= 0.0 : center[2] - radius >= 0.0) ||
+    std::abs(center[2]) + radius < halfLength - this->Radius;
+  return radial && axial;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutCylinderTool::EvaluateTranslatedDistances(
+  const double motion[3], double step, const float* x, const float* y, const float* z, int count, float* distances)
+{
+  // Moved across its axis, a cylinder sweeps a 2D capsule times its length:
+  // exact. The motion along the axis is taken in pieces no longer than
+  // step: piece k sweeps across from where the tool is at t = k / n to
+  // where it is at (k + 1) / n, at the height of the latter. The union is
+  // within step of the sweep and holds the end pose exactly (a continuing
+  // sweep relies on the field holding it).
+  if (!(step > 0.0))
+  {
+    return false;
+  }
+  const int pieces = std::max(1, static_cast<int>(std::ceil(std::abs(motion[2]) / step)));
+  const float segment[2] = { static_cast<float>(motion[0] / pieces), static_cast<float>(motion[1] / pieces) };
+  const double length2 = static_cast<double>(segment[0]) * segment[0] + static_cast<double>(segment[1]) * segment[1];
+  const float inverseLength2 = length2 > 0.0 ? static_cast<float>(1.0 / length2) : 0.0f;
+  const vtkVolumeCutKernels::Table& kernels = vtkVolumeCutKernels::Get();
+  std::fill(distances, distances + count, std::numeric_limits<float>::max());
+  for (int piece = 0; piece < pieces; ++piece)
+  {
+    const double start = static_cast<double>(piece) / pieces;
+    const double end = static_cast<double>(piece + 1) / pieces;
+    const float offset[3] = { static_cast<float>(start * motion[0]), static_cast<float>(start * motion[1]), static_cast<float>(end * motion[2]) };
+    kernels.CylinderSweptMinimum(
+      static_cast<float>(this->Radius), static_cast<float>(0.5 * this->Length), offset, segment, inverseLength2, x, y, z, count, distances);
+  }
+  return true;
 }
 
 //------------------------------------------------------------------------------

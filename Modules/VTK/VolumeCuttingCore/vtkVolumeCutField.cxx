@@ -299,6 +299,7 @@ void vtkVolumeCutField::Reset()
   this->StrokeBeforeMemory = 0;
   this->Protection->RemoveAllLabelImages();
   this->LastCapsule.Valid = false;
+  this->LastToolSweep.Valid = false;
   this->ResetContact();
 }
 
@@ -307,6 +308,7 @@ void vtkVolumeCutField::ResetContact()
 {
   // The next capsule reports its whole reach again, the ball it starts in too.
   this->LastCapsule.Valid = false;
+  this->LastToolSweep.Valid = false;
   this->MaximumContactDepth = 0.0;
   this->ContactLabel = 0;
   std::fill(this->ContactPosition, this->ContactPosition + 3, 0.0);
@@ -562,8 +564,26 @@ bool vtkVolumeCutField::ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pos
   this->GetSubVoxelSpacing(spacing);
   const double step = 0.5 * std::min({ spacing[0], spacing[1], spacing[2] });
   std::vector<vtkVolumeCutSweeps::RigidPose> poses = vtkVolumeCutSweeps::InterpolatePoses(start, end, tool->GetBoundingRadius(), step);
-  const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), tool->GetBoundingRadius() + this->BandWidth);
+  // A sweep that starts where the last one ended, on an unchanged field, has
+  // its first pose cut already; a pure translation then leaves whole regions
+  // behind (vtkVolumeCutSweepSources). Paths of a haptic stroke are such sweeps.
+  const ToolSweepContinuation& last = this->LastToolSweep;
+  const bool continued = operation == Operation::Cut && last.Valid && last.Tool == tool && last.ToolTime == tool->GetMTime() &&
+    last.Stamp == this->GetCurrentStamp() && last.ProtectionTime == this->Protection->GetMTime() &&
+    std::equal(&start.Rotation[0][0], &start.Rotation[0][0] + 9, &last.End.Rotation[0][0]) &&
+    std::equal(start.Translation, start.Translation + 3, last.End.Translation);
+  const bool translation = std::equal(&start.Rotation[0][0], &start.Rotation[0][0] + 9, &end.Rotation[0][0]);
+  const double motion[3] = { end.Translation[0] - start.Translation[0], end.Translation[1] - start.Translation[1],
+    end.Translation[2] - start.Translation[2] };
+  const vtkVolumeCutSweeps::SweptToolSource source(tool, std::move(poses), this->BandWidth, step, continued, translation ? motion : nullptr);
   this->ApplyDistance(source, operation);
+  this->LastToolSweep.Valid = operation == Operation::Cut;
+  this->LastToolSweep.Tool = tool;
+  this->LastToolSweep.ToolTime = tool->GetMTime();
+  std::copy(&end.Rotation[0][0], &end.Rotation[0][0] + 9, &this->LastToolSweep.End.Rotation[0][0]);
+  std::copy(end.Translation, end.Translation + 3, this->LastToolSweep.End.Translation);
+  this->LastToolSweep.Stamp = this->GetCurrentStamp();
+  this->LastToolSweep.ProtectionTime = this->Protection->GetMTime();
   return true;
 }
 
@@ -681,6 +701,7 @@ bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* 
     keepOut, this->RASToSubIJK, this->BrickDimensions, this->Quantum, 0.5 * std::max({ spacing[0], spacing[1], spacing[2] }), keepBricks);
   this->ApplyDistance(source, Operation::Cut);
   this->LastCapsule.Valid = false;
+  this->LastToolSweep.Valid = false;
   return true;
 }
 
@@ -1700,6 +1721,7 @@ void vtkVolumeCutField::ReplaceBricks(const BrickStates& bricks)
   this->RedoStack.clear();
   this->UndoMemorySize = 0;
   this->LastCapsule.Valid = false;
+  this->LastToolSweep.Valid = false;
   this->WriteBricks(bricks);
 }
 

@@ -495,6 +495,23 @@ protected:
     vtkMTimeType ProtectionTime = 0;
   };
   CapsuleContinuation LastCapsule;
+  /// The same for the last tool sweep: a sweep that starts at the pose where
+  /// the last one ended, with the same tool, need not cut its first pose again.
+  struct ToolSweepContinuation
+  {
+    bool Valid = false;
+    vtkVolumeCutTool* Tool = nullptr;
+    vtkMTimeType ToolTime = 0;
+    /// Rotation (tool-to-RAS) and translation of the last pose.
+    struct
+    {
+      double Rotation[3][3];
+      double Translation[3];
+    } End = {};
+    vtkTypeUInt64 Stamp = 0;
+    vtkMTimeType ProtectionTime = 0;
+  };
+  ToolSweepContinuation LastToolSweep;
   double MaximumStrokeLength = 50.0;
   double SubIJKToRAS[4][4];
   double AnatomyIJKToRAS[16];

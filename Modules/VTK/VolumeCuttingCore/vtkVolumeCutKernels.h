@@ -52,6 +52,11 @@ struct Table
   void (*EllipsoidDistances)(const float inverse[3], const float inverse2[3], float centre, const float* x, const float* y, const float* z,
     int count, float* distances);
   void (*BoxDistances)(const float half[3], const float* x, const float* y, const float* z, int count, float* distances);
+  /// distances = min(distances, distance to a cylinder swept across its
+  /// cross-section): the disk of radius about offset (x, y) moved along
+  /// segment (x, y), times the slab offset[2] +- halfLength.
+  void (*CylinderSweptMinimum)(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+    const float* x, const float* y, const float* z, int count, float* distances);
 };
 
 /// The kernels of the set in use: the widest this build and processor have,

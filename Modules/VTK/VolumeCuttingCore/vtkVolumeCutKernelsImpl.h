@@ -142,7 +142,32 @@ void BoxDistances(const float half[3], const float* x, const float* y, const flo
     distances[n] = sqrtf(ox * ox + oy * oy + oz * oz) + (largest < 0.0f ? largest : 0.0f);
   }
 }
+void CylinderSweptMinimum(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+  const float* x, const float* y, const float* z, int count, float* __restrict distances)
+{
+  const float ox = offset[0], oy = offset[1], oz = offset[2];
+  const float sx = segment[0], sy = segment[1];
+  for (int n = 0; n < count; ++n)
+  {
+    // The cross-section: distance to the segment, less the radius (a 2D capsule).
+    const float px = x[n] - ox;
+    const float py = y[n] - oy;
+    float along = (px * sx + py * sy) * inverseSegmentLength2;
+    along = along < 0.0f ? 0.0f : along;
+    along = along > 1.0f ? 1.0f : along;
+    const float dx = px - along * sx;
+    const float dy = py - along * sy;
+    const float radial = sqrtf(dx * dx + dy * dy) - radius;
+    // Times the slab: as a cylinder's distance combines its disk and its length.
+    const float axial = fabsf(z[n] - oz) - halfLength;
+    const float outsideRadial = radial > 0.0f ? radial : 0.0f;
+    const float outsideAxial = axial > 0.0f ? axial : 0.0f;
+    const float larger = radial > axial ? radial : axial;
+    const float distance = sqrtf(outsideRadial * outsideRadial + outsideAxial * outsideAxial) + (larger < 0.0f ? larger : 0.0f);
+    distances[n] = distance < distances[n] ? distance : distances[n];
+  }
+}
 } // namespace
 
 const vtkVolumeCutKernels::Table vtkVolumeCutKernels::VOLUMECUTTING_KERNELS_TABLE = { CapsuleBrickDistances, ToToolFrame, MergeCopy, QuantizeRun,
-  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances };
+  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances, CylinderSweptMinimum };

@@ -198,11 +198,31 @@ void CapsuleSource::BrickDistances(const double origin[3], const double* /*cente
 }
 
 //------------------------------------------------------------------------------
-SweptToolSource::SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach)
+SweptToolSource::SweptToolSource(
+  vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, double step, bool startCovered, const double* motion)
   : Tool(tool)
   , Poses(std::move(poses))
-  , Reach(reach)
+  , Band(band)
+  , Reach(tool->GetBoundingRadius() + band)
+  , FirstCopy(startCovered && this->Poses.size() > 1 ? 1 : 0)
+  , Step(step)
 {
+  if (motion && !this->Poses.empty())
+  {
+    // The motion in the first copy's frame.
+    const RigidPose& first = this->Poses.front();
+    for (int row = 0; row < 3; ++row)
+    {
+      this->Motion[row] = first.Rotation[0][row] * motion[0] + first.Rotation[1][row] * motion[1] + first.Rotation[2][row] * motion[2];
+    }
+    this->Translation = true;
+    this->UseMotion = startCovered;
+    // Whether the tool has a closed form for its translated sweep (asked at one point).
+    const float origin = 0.0f;
+    float distance = 0.0f;
+    this->ClosedForm = tool->EvaluateTranslatedDistances(this->Motion, step, &origin, &origin, &origin, 1, &distance);
+  }
+  this->Meeting.assign(this->Poses.size(), 0);
 }
 
 //------------------------------------------------------------------------------
@@ -221,33 +241,79 @@ void SweptToolSource::GetReachBounds(double lower[3], double upper[3]) const
 }
 
 //------------------------------------------------------------------------------
-bool SweptToolSource::MayReach(const double center[3], double radius) const
+const std::vector<char>& SweptToolSource::Copies(const double center[3], double radius) const
 {
-  for (const RigidPose& pose : this->Poses)
+  if (radius != this->MeetingRadius || center[0] != this->MeetingCenter[0] || center[1] != this->MeetingCenter[1] ||
+    center[2] != this->MeetingCenter[2])
   {
-    if (this->Meets(pose, center, radius))
+    std::copy(center, center + 3, this->MeetingCenter);
+    this->MeetingRadius = radius;
+    std::fill(this->Meeting.begin(), this->Meeting.end(), 0);
+    bool behind = false;
+    if (this->UseMotion)
     {
-      return true;
+      const RigidPose& first = this->Poses.front();
+      const double w[3] = { center[0] - first.Translation[0], center[1] - first.Translation[1], center[2] - first.Translation[2] };
+      double local[3];
+      for (int row = 0; row < 3; ++row)
+      {
+        local[row] = first.Rotation[0][row] * w[0] + first.Rotation[1][row] * w[1] + first.Rotation[2][row] * w[2];
+      }
+      behind = this->Tool->IsLeftBehind(local, radius, this->Motion);
+    }
+    if (this->ClosedForm && !behind)
+    {
+      // Every point of a translated sweep is within half the motion of the
+      // first or the last copy: those two bound the whole sweep's reach (the
+      // copies of the closed form's path need no test of their own).
+      const double halfMotion = 0.5 * std::sqrt(this->Motion[0] * this->Motion[0] + this->Motion[1] * this->Motion[1] + this->Motion[2] * this->Motion[2]);
+      const bool reaches = this->Meets(this->Poses.front(), center, radius + halfMotion) || this->Meets(this->Poses.back(), center, radius + halfMotion);
+      for (size_t n = this->FirstCopy; n < this->Poses.size(); ++n)
+      {
+        this->Meeting[n] = reaches ? 1 : 0;
+      }
+    }
+    else
+    {
+      for (size_t n = this->FirstCopy; n < this->Poses.size() && !behind; ++n)
+      {
+        this->Meeting[n] = this->Meets(this->Poses[n], center, radius) ? 1 : 0;
+      }
     }
   }
-  return false;
+  return this->Meeting;
+}
+
+//------------------------------------------------------------------------------
+bool SweptToolSource::MayReach(const double center[3], double radius) const
+{
+  const std::vector<char>& meeting = this->Copies(center, radius);
+  return std::find(meeting.begin(), meeting.end(), 1) != meeting.end();
 }
 
 //------------------------------------------------------------------------------
 void SweptToolSource::BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const
 {
   // Beyond the band: clamped to Outside, so a copy out of reach changes nothing.
+  float local[3][SamplesPerBrick];
+  if (this->ClosedForm)
+  {
+    // One evaluation of the whole translated sweep.
+    ToToolFrame(this->Poses.front(), origin, offsets, local);
+    this->Tool->EvaluateTranslatedDistances(this->Motion, this->Step, local[0], local[1], local[2], SamplesPerBrick, distances);
+    return;
+  }
   const float far = static_cast<float>(this->Reach);
   std::fill(distances, distances + SamplesPerBrick, far);
-  float local[3][SamplesPerBrick];
   float copy[SamplesPerBrick];
-  for (const RigidPose& pose : this->Poses)
+  const std::vector<char>& meeting = this->Copies(center, radius);
+  for (size_t n = 0; n < this->Poses.size(); ++n)
   {
-    if (!this->Meets(pose, center, radius))
+    if (!meeting[n])
     {
       continue;
     }
-    ToToolFrame(pose, origin, offsets, local);
+    ToToolFrame(this->Poses[n], origin, offsets, local);
     this->Tool->EvaluateDistances(local[0], local[1], local[2], SamplesPerBrick, copy);
     vtkVolumeCutKernels::Get().MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
   }
@@ -280,6 +346,20 @@ bool SweptToolSource::Meets(const RigidPose& pose, const double center[3], doubl
 {
   const double w[3] = { center[0] - pose.Translation[0], center[1] - pose.Translation[1], center[2] - pose.Translation[2] };
   const double limit = this->Reach + radius;
-  return w[0] * w[0] + w[1] * w[1] + w[2] * w[2] <= limit * limit;
+  if (w[0] * w[0] + w[1] * w[1] + w[2] * w[2] > limit * limit)
+  {
+    return false;
+  }
+  // The tool's own distance at the centre, less the ball's radius, bounds it
+  // below over the ball (a distance changes no faster than the point moves;
+  // far from the surface a tool may underestimate, which only keeps more).
+  // Beyond the band every sample would be clamped to Outside: no change. The
+  // margin covers single-precision rounding of the samples' distances.
+  double local[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    local[row] = pose.Rotation[0][row] * w[0] + pose.Rotation[1][row] * w[1] + pose.Rotation[2][row] * w[2];
+  }
+  return this->Tool->EvaluateDistance(local) - radius <= this->Band + 1e-3;
 }
 } // namespace vtkVolumeCutSweeps

@@ -61,24 +61,47 @@ private:
 
 /// The sweep of any tool: the tool at poses close enough that the union of
 /// its copies covers the continuous sweep to within half a sub-voxel. Written
-/// a brick at a time: each copy whose reach sphere meets a brick is evaluated
-/// at all its samples in one batch (vtkVolumeCutTool::EvaluateDistances).
+/// a brick at a time: each copy that comes within the band of a brick (the
+/// tool's own distance at the brick's centre says so) is evaluated at all its
+/// samples in one batch (vtkVolumeCutTool::EvaluateDistances).
+///
+/// A pure translation (motion, RAS; nullptr otherwise) of a tool with a
+/// closed form for its translated sweep is evaluated once per brick instead
+/// of once per copy (vtkVolumeCutTool::EvaluateTranslatedDistances, within
+/// step of the exact sweep). A sweep that continues the previous one
+/// (startCovered: the field holds the copy at the first pose already) skips
+/// that copy; a continuing translation moreover skips every brick the tool
+/// leaves behind (vtkVolumeCutTool::IsLeftBehind): there no copy is nearer
+/// than the first one, which the field holds. A tool moving along its path
+/// therefore costs the bricks ahead of it, not all it touches.
 class SweptToolSource : public vtkVolumeCutField::BrickDistanceSource
 {
 public:
-  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double reach);
+  SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, double step, bool startCovered, const double* motion);
   void GetReachBounds(double lower[3], double upper[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
   void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override;
   double Distance(const double point[3]) const override;
 
 private:
-  /// Whether the copy of the tool at pose reaches into the ball.
+  /// Whether the copy of the tool at pose reaches into the band around the ball.
   bool Meets(const RigidPose& pose, const double center[3], double radius) const;
+  /// Which copies meet the ball (cached for the brick MayReach saw last).
+  const std::vector<char>& Copies(const double center[3], double radius) const;
 
   vtkVolumeCutTool* Tool;
   std::vector<RigidPose> Poses;
+  double Band;
   double Reach;
+  size_t FirstCopy;
+  double Step;
+  bool Translation = false;
+  bool ClosedForm = false;
+  bool UseMotion = false;
+  double Motion[3] = { 0.0, 0.0, 0.0 };
+  mutable std::vector<char> Meeting;
+  mutable double MeetingCenter[3] = { 0.0, 0.0, 0.0 };
+  mutable double MeetingRadius = -1.0;
 };
 } // namespace vtkVolumeCutSweeps
 

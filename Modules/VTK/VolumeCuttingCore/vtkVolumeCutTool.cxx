@@ -17,3 +17,15 @@ void vtkVolumeCutTool::EvaluateDistances(const float* x, const float* y, const f
     distances[n] = static_cast<float>(this->EvaluateDistance(local));
   }
 }
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutTool::IsLeftBehind(const double*, double, const double*)
+{
+  return false;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutTool::EvaluateTranslatedDistances(const double*, double, const float*, const float*, const float*, int, float*)
+{
+  return false;
+}

@@ -40,6 +40,29 @@ public:
   /// Radius (mm) of a sphere about the local origin that holds the tool.
   virtual double GetBoundingRadius() = 0;
 
+  /**
+   * Whether the ball of the given radius about center (tool frame, mm) is
+   * left behind when the tool translates by any positive multiple of motion
+   * (tool frame): the tool's distance gets no smaller anywhere in the ball,
+   * because the distance's gradient there has no component along motion. A
+   * sweep continuing the previous one, which already cut the first pose,
+   * need not compute such regions again. The default, false (not known), is
+   * always safe; convex tools with a closed form answer from their geometry.
+   */
+  virtual bool IsLeftBehind(const double center[3], double radius, const double motion[3]);
+
+  /**
+   * Distances (as EvaluateDistances) to the volume the tool sweeps when it
+   * translates by motion (tool frame, mm), for tools with a closed form for
+   * it: exact, or within step of the exact sweep and no larger than the
+   * distance to the union of copies step apart. Returns false, writing
+   * nothing, for tools without one (the default): the sweep is then made of
+   * copies. One evaluation instead of one per copy is what lets non-spherical
+   * burrs keep up with a haptic loop.
+   */
+  VTK_WRAPEXCLUDE virtual bool EvaluateTranslatedDistances(
+    const double motion[3], double step, const float* x, const float* y, const float* z, int count, float* distances);
+
   /// Whether the tool can cut: finite, positive sizes (and a closed surface for
   /// meshes). Logs an error saying what is wrong otherwise.
   virtual bool IsValid() = 0;

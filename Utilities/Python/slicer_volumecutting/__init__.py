@@ -9,6 +9,7 @@ import slicer_core  # noqa: F401  (loads VTK and Slicer's libraries our modules 
 from .vtkVolumeCuttingCore import *  # noqa: F401,F403
 from .vtkVolumeCuttingRendering import *  # noqa: F401,F403
 from .vtkVolumeCuttingSoftCut import *  # noqa: F401,F403
+from .vtkVolumeCuttingHaptics import *  # noqa: F401,F403
 from .vtkSlicerVolumeCuttingModuleMRML import *  # noqa: F401,F403
 from .vtkSlicerVolumeCuttingModuleLogic import *  # noqa: F401,F403
 from .vtkSlicerVolumeCuttingModuleMRMLDisplayableManager import *  # noqa: F401,F403

@@ -32,16 +32,7 @@ def session():
     labels[ct > 0] = 1
     labels[(ct > 0) & (i >= 30)] = 2  # "Cortex": a slab of the block
     labels[(ct > 0) & ((j - 24) ** 2 + (k - 15) ** 2 <= 4) & (i < 30)] = 3  # "Nerve": a canal along i
-    segmentation = scene.AddNewNodeByClass("vtkMRMLSegmentationNode", "Anatomy")
-    segmentation.SetReferenceImageGeometryParameterFromVolumeNode(volume)
-    for value, name in ((1, "Bone"), (2, "Cortex"), (3, "Nerve")):
-        mask = slicer.vtkOrientedImageData()
-        mask.ShallowCopy(nodes.image_data_from_array((labels == value).astype(np.uint8)))
-        mask.SetImageToWorldMatrix(nodes.numpy_to_vtk_matrix(ijk_to_ras))
-        segment = slicer.vtkSegment()
-        segment.SetName(name)
-        segment.AddRepresentation("Binary labelmap", mask)
-        segmentation.GetSegmentation().AddSegment(segment, name)
+    segmentation = nodes.create_segmentation_from_labels(scene, volume, labels, {1: "Bone", 2: "Cortex", 3: "Nerve"}, "Anatomy")
     cut = logic.AddVolumeCutNode(volume, segmentation)
     cut.SetCuttableSegmentIDs(["Bone", "Cortex"])
     cut.SetProtectedSegmentIDs(["Nerve"])

@@ -488,6 +488,12 @@ def mapper(repeats: int) -> list[dict]:
     return mapperbenchmarks.mapper(repeats)
 
 
+def haptics(repeats: int) -> list[dict]:
+    from . import hapticbenchmarks
+
+    return hapticbenchmarks.haptics(repeats)
+
+
 def sliceview(repeats: int) -> list[dict]:
     from . import slicebenchmarks
 
@@ -511,6 +517,7 @@ AREAS = {
     "cutfield": cutfield,
     "mapper": mapper,
     "workflow": workflow,
+    "haptics": haptics,
     "sliceview": sliceview,
     "softcut": softcut,
 }

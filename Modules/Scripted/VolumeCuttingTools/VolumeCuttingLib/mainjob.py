@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import slicer
 
-from . import drilling, headct, owndata, phantom, recording, selftests, softcutjob, toolconfig
+from . import drilling, hapticsjob, headct, owndata, phantom, recording, selftests, softcutjob, toolconfig
 from .application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
@@ -227,6 +227,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     drilled["contact_events"] = contact_table.GetNumberOfRows()
     drilled["removed_volume_table"] = {
         volume_table.GetCellText(row, 0): float(volume_table.GetCellText(row, 3)) for row in range(volume_table.GetNumberOfRows())}
+    # Then a session through the haptic path, beside the cavity: what it cuts
+    # adds to the recorded mastoidectomy's volume in the tables that follow.
+    with timer.measure("haptics_s"):
+        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
     removed_per_segment = {
         segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
         for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
@@ -325,6 +329,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
                 "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
             },
         },
+        "haptics": haptics,
         "exports": {
             "removed_segmentation": removed.GetName(),
             "removed_fraction_volume": removed_fraction.GetName(),

@@ -93,3 +93,27 @@ def array_from_volume_node(volume_node):
     if image is None:
         raise ValueError(f"volume node {volume_node.GetName()!r} has no image data")
     return array_from_image_data(image)
+
+
+def create_segmentation_from_labels(scene, volume_node, labels_kji, names, name):
+    """Add a ``vtkMRMLSegmentationNode`` on ``volume_node``'s grid with one segment per label.
+
+    ``names`` maps label values of ``labels_kji`` (indexed ``[k, j, i]`` like the
+    volume) to segment names, which are also the segment IDs; each segment
+    gets its own binary labelmap of the voxels with that value.
+    """
+    import slicer
+
+    segmentation_node = scene.AddNewNodeByClass("vtkMRMLSegmentationNode", name)
+    segmentation_node.SetReferenceImageGeometryParameterFromVolumeNode(volume_node)
+    image_to_world = numpy_to_vtk_matrix(volume_node_ijk_to_ras(volume_node))
+    labels_kji = np.asarray(labels_kji)
+    for value, segment_name in names.items():
+        mask = slicer.vtkOrientedImageData()
+        mask.ShallowCopy(image_data_from_array((labels_kji == value).astype(np.uint8)))
+        mask.SetImageToWorldMatrix(image_to_world)
+        segment = slicer.vtkSegment()
+        segment.SetName(segment_name)
+        segment.AddRepresentation("Binary labelmap", mask)
+        segmentation_node.GetSegmentation().AddSegment(segment, segment_name)
+    return segmentation_node

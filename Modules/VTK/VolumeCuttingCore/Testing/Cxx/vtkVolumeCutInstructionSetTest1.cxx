@@ -72,6 +72,28 @@ Snapshot CutEverything(double& removedVolume)
     field->CutToolSweep(tool, start->GetMatrix(), end->GetMatrix());
     y += 4.5;
   }
+  // Pure translations continued pose to pose, as a haptic stroke makes
+  // them: the cylinder's closed-form sweep (across and along its axis) and
+  // the regions the tools leave behind.
+  vtkNew<vtkVolumeCutCylinderTool> disk;
+  disk->SetRadius(3.0);
+  disk->SetLength(0.5);
+  vtkVolumeCutTool* translated[] = { cylinder, disk, blade };
+  double z = 4.0;
+  for (vtkVolumeCutTool* tool : translated)
+  {
+    vtkNew<vtkMatrix4x4> previous;
+    for (int n = 0; n <= 12; ++n)
+    {
+      vtkNew<vtkTransform> pose;
+      pose->Translate(9.0 + 0.4 * n, 13.0 + 0.25 * n, z + (n < 6 ? 0.0 : 0.3 * (n - 6)));
+      pose->RotateWXYZ(35.0, 1.0, 0.3, 0.0);
+      field->CutToolSweep(tool, n == 0 ? pose->GetMatrix() : previous.GetPointer(), pose->GetMatrix());
+      previous->DeepCopy(pose->GetMatrix());
+    }
+    z += 3.5;
+  }
+
   vtkNew<vtkTransform> restorePose;
   restorePose->Translate(6.0, 8.0, 12.5);
   field->RestoreToolSweep(ellipsoid, restorePose->GetMatrix(), restorePose->GetMatrix());

@@ -1,0 +1,907 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkHapticLoop.h"
+#include "vtkHapticDevice.h"
+#include "vtkHapticDeviceCapabilities.h"
+#include "vtkHapticForceModel.h"
+#include "vtkHapticLatestValue.h"
+#include "vtkHapticRecorder.h"
+#include "vtkHapticRing.h"
+
+#include "vtkMath.h"
+#include "vtkMatrix4x4.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkVolumeCutField.h"
+#include "vtkVolumeCutTool.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#if defined(__linux__)
+#include <pthread.h>
+#include <sched.h>
+#endif
+
+vtkStandardNewMacro(vtkHapticLoop);
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+enum EventTypes
+{
+  CutEvent,
+  DrillPressEvent,
+  DrillReleaseEvent,
+  LostEvent,
+  ReturnEvent,
+  FailedCutEvent
+};
+
+/// What the haptic thread reports to the main thread.
+struct Event
+{
+  unsigned long long Tick;
+  int Type;
+  double P0[3];
+  double P1[3];
+};
+
+/// What the display reads.
+struct Display
+{
+  double ToolToRAS[16];
+  double Force[3];
+  int Drilling;
+  double ContactDepth;
+};
+
+/// A hint to the processor inside a wait loop.
+inline void Relax()
+{
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
+double Percentile(std::vector<float> values, double percent)
+{
+  if (values.empty())
+  {
+    return 0.0;
+  }
+  const double rank = std::min(std::max(percent, 0.0), 100.0) / 100.0 * (values.size() - 1);
+  const size_t index = static_cast<size_t>(std::ceil(rank));
+  std::nth_element(values.begin(), values.begin() + index, values.end());
+  return values[index];
+}
+} // namespace
+
+struct vtkHapticLoop::Internals
+{
+  vtkSmartPointer<vtkHapticDevice> Device;
+  vtkSmartPointer<vtkHapticDevice> Switch;
+  vtkSmartPointer<vtkHapticForceModel> Model;
+  vtkSmartPointer<vtkVolumeCutField> Field;
+  vtkSmartPointer<vtkHapticRecorder> Recorder;
+  double DeviceToRAS[4][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } };
+  double Scale = 1.0;
+  double MapRotation[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  double ToolRotation[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+
+  std::thread Thread;
+  std::atomic<bool> StopRequested{ false };
+  std::atomic<bool> Running{ false };
+  bool Prepared = false;
+  vtkHapticRing<Event> Events{ 8192 };
+  vtkHapticLatestValue<Display> Latest;
+  double LastSegment[2][3] = { { 0, 0, 0 }, { 0, 0, 0 } };
+
+  // Haptic thread's state.
+  std::atomic<unsigned long long> TickCount{ 0 };
+  bool WasPresent = false;
+  bool EverPresent = false;
+  bool HaveSample = false;
+  vtkHapticDevice::Sample PreviousSample;
+  bool NeedsReset = true;
+  bool StrokeOpen = false;
+  bool LastCutValid = false;
+  double LastCut[3] = { 0, 0, 0 };
+  double LastCutRotation[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+  vtkVolumeCutTool* Tool = nullptr;
+  double Radius = 0.0;
+  vtkNew<vtkMatrix4x4> Pose0;
+  vtkNew<vtkMatrix4x4> Pose1;
+
+  // Statistics: written by the haptic thread, read while stopped.
+  std::vector<float> Durations;
+  std::vector<float> Jitters;
+  std::atomic<unsigned long long> Timed{ 0 };
+  std::atomic<unsigned long long> Jittered{ 0 };
+  std::atomic<unsigned long long> Overruns{ 0 };
+  bool RealTime = false;
+
+  /// Haptic thread: a report for the main thread (counted, not kept, when the ring is full).
+  void Push(unsigned long long tick, int type, const double p0[3] = nullptr, const double p1[3] = nullptr)
+  {
+    Event event{};
+    event.Tick = tick;
+    event.Type = type;
+    if (p0)
+    {
+      std::copy(p0, p0 + 3, event.P0);
+    }
+    if (p1)
+    {
+      std::copy(p1, p1 + 3, event.P1);
+    }
+    if (!this->Events.Push(event))
+    {
+      this->DroppedEvents.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+  std::atomic<int> DroppedEvents{ 0 };
+};
+
+//------------------------------------------------------------------------------
+vtkHapticLoop::vtkHapticLoop()
+  : Internal(new Internals)
+{
+  Display display{};
+  for (int n = 0; n < 16; ++n)
+  {
+    display.ToolToRAS[n] = (n % 5 == 0) ? 1.0 : 0.0;
+  }
+  this->Internal->Latest.Store(display);
+}
+
+//------------------------------------------------------------------------------
+vtkHapticLoop::~vtkHapticLoop()
+{
+  this->Stop();
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetDevice(vtkHapticDevice* device)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetDevice: stop the loop first");
+    return;
+  }
+  this->Internal->Device = device;
+  this->Internal->Prepared = false;
+  this->Modified();
+}
+
+vtkHapticDevice* vtkHapticLoop::GetDevice()
+{
+  return this->Internal->Device;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetSwitchDevice(vtkHapticDevice* device)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetSwitchDevice: stop the loop first");
+    return;
+  }
+  this->Internal->Switch = device;
+  this->Modified();
+}
+
+vtkHapticDevice* vtkHapticLoop::GetSwitchDevice()
+{
+  return this->Internal->Switch;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetForceModel(vtkHapticForceModel* model)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetForceModel: stop the loop first");
+    return;
+  }
+  this->Internal->Model = model;
+  this->Internal->Prepared = false;
+  this->Modified();
+}
+
+vtkHapticForceModel* vtkHapticLoop::GetForceModel()
+{
+  return this->Internal->Model;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetCutField(vtkVolumeCutField* field)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetCutField: stop the loop first");
+    return;
+  }
+  this->Internal->Field = field;
+  this->Internal->Prepared = false;
+  this->Modified();
+}
+
+vtkVolumeCutField* vtkHapticLoop::GetCutField()
+{
+  return this->Internal->Field;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetRecorder(vtkHapticRecorder* recorder)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetRecorder: stop the loop first");
+    return;
+  }
+  this->Internal->Recorder = recorder;
+  this->Modified();
+}
+
+vtkHapticRecorder* vtkHapticLoop::GetRecorder()
+{
+  return this->Internal->Recorder;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::SetDeviceToRAS(vtkMatrix4x4* deviceToRAS)
+{
+  if (!deviceToRAS || this->IsRunning())
+  {
+    vtkErrorMacro("SetDeviceToRAS: " << (deviceToRAS ? "stop the loop first" : "a matrix is required"));
+    return false;
+  }
+  double columns[3][3];
+  double scale = 0.0;
+  for (int column = 0; column < 3; ++column)
+  {
+    for (int row = 0; row < 3; ++row)
+    {
+      columns[column][row] = deviceToRAS->GetElement(row, column);
+    }
+    scale += vtkMath::Norm(columns[column]) / 3.0;
+  }
+  bool valid = std::isfinite(scale) && scale > 0.0 && deviceToRAS->GetElement(3, 0) == 0.0 && deviceToRAS->GetElement(3, 1) == 0.0 &&
+    deviceToRAS->GetElement(3, 2) == 0.0 && deviceToRAS->GetElement(3, 3) == 1.0;
+  for (int a = 0; a < 3 && valid; ++a)
+  {
+    valid = std::isfinite(deviceToRAS->GetElement(a, 3));
+    for (int b = 0; b < 3 && valid; ++b)
+    {
+      const double dot = vtkMath::Dot(columns[a], columns[b]) / (scale * scale);
+      valid = std::abs(dot - (a == b ? 1.0 : 0.0)) < 1e-6;
+    }
+  }
+  if (!valid || deviceToRAS->Determinant() <= 0.0)
+  {
+    vtkErrorMacro("SetDeviceToRAS: the matrix must be a rotation times a uniform scale plus a translation; the previous one is kept");
+    return false;
+  }
+  Internals& internal = *this->Internal;
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      internal.DeviceToRAS[row][column] = deviceToRAS->GetElement(row, column);
+    }
+  }
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      internal.MapRotation[row][column] = internal.DeviceToRAS[row][column] / scale;
+    }
+  }
+  internal.Scale = scale;
+  internal.Prepared = false;
+  this->Modified();
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::GetDeviceToRAS(vtkMatrix4x4* deviceToRAS)
+{
+  if (deviceToRAS)
+  {
+    deviceToRAS->DeepCopy(&this->Internal->DeviceToRAS[0][0]);
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetDeviceScale() const
+{
+  return this->Internal->Scale;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SetToolRotation(vtkMatrix4x4* rotation)
+{
+  if (!rotation || this->IsRunning())
+  {
+    vtkErrorMacro("SetToolRotation: " << (rotation ? "stop the loop first" : "a matrix is required"));
+    return;
+  }
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      this->Internal->ToolRotation[row][column] = rotation->GetElement(row, column);
+    }
+  }
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::IsRunning() const
+{
+  return this->Internal->Running.load(std::memory_order_acquire);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::Prepare()
+{
+  Internals& internal = *this->Internal;
+  if (!internal.Device || !internal.Device->IsConnected())
+  {
+    vtkErrorMacro("Start: " << (internal.Device ? "the device is not connected; open it first" : "no device is set"));
+    return false;
+  }
+  if (!internal.Model)
+  {
+    vtkErrorMacro("Start: no force model is set");
+    return false;
+  }
+  vtkHapticDeviceCapabilities* capabilities = internal.Device->GetCapabilities();
+  internal.Model->SetDeviceLimits(capabilities, internal.Scale);
+  // Four samples a period at least: what the loop and the device can render.
+  internal.Model->SetMaximumVibrationFrequency(0.25 * std::min(this->Rate, capabilities->GetUpdateRate()));
+  if (internal.Field)
+  {
+    internal.Model->SetCutField(internal.Field);
+  }
+  if (!internal.Model->Prepare())
+  {
+    vtkErrorMacro("Start: the force model could not be prepared (see the error above)");
+    return false;
+  }
+  internal.Tool = internal.Model->GetTool();
+  internal.Radius = internal.Model->GetSphereRadius();
+  if (internal.Recorder)
+  {
+    internal.Recorder->GetCapabilities()->DeepCopy(capabilities);
+    internal.Recorder->SetRate(this->Rate);
+  }
+  internal.Durations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
+  internal.Jitters.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
+  internal.Timed = 0;
+  internal.Jittered = 0;
+  internal.Overruns = 0;
+  internal.TickCount = 0;
+  internal.WasPresent = internal.EverPresent = internal.HaveSample = false;
+  internal.NeedsReset = true;
+  internal.StrokeOpen = false;
+  internal.LastCutValid = false;
+  this->NumberOfCutStrokes = this->NumberOfDrillPresses = this->NumberOfDrillReleases = this->NumberOfDeviceLosses = 0;
+  this->NumberOfDeviceReturns = this->NumberOfFailedCuts = this->NumberOfDroppedEvents = 0;
+  internal.DroppedEvents = 0;
+  Event stale;
+  while (internal.Events.Pop(stale))
+  {
+  }
+  internal.Prepared = true;
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::Start()
+{
+  Internals& internal = *this->Internal;
+  if (this->IsRunning())
+  {
+    return true;
+  }
+  if (!this->Prepare())
+  {
+    return false;
+  }
+  internal.StopRequested = false;
+  internal.RealTime = false;
+  internal.Running = true;
+  internal.Thread = std::thread([this]() { this->Run(); });
+#if defined(__linux__)
+  // Real-time priority and a processor of its own where the system grants
+  // them (it usually refuses both to unprivileged users: then the loop runs
+  // at normal priority and its jitter shows it).
+  sched_param parameters{};
+  parameters.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
+  internal.RealTime = pthread_setschedparam(internal.Thread.native_handle(), SCHED_FIFO, &parameters) == 0;
+  if (this->ProcessorIndex >= 0 && this->ProcessorIndex < CPU_SETSIZE)
+  {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(this->ProcessorIndex, &set);
+    pthread_setaffinity_np(internal.Thread.native_handle(), sizeof(set), &set);
+  }
+#endif
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::Stop()
+{
+  Internals& internal = *this->Internal;
+  if (internal.Thread.joinable())
+  {
+    internal.StopRequested = true;
+    internal.Thread.join();
+  }
+  else if (internal.Prepared)
+  {
+    this->Finish();
+  }
+  internal.Running = false;
+  internal.Prepared = false;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::RunTicks(int count)
+{
+  Internals& internal = *this->Internal;
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("RunTicks: the loop's thread is running; stop it first");
+    return false;
+  }
+  if (!internal.Prepared && !this->Prepare())
+  {
+    return false;
+  }
+  const double timeStep = 1.0 / this->Rate;
+  for (int n = 0; n < count; ++n)
+  {
+    const Clock::time_point start = Clock::now();
+    this->Tick(timeStep);
+    const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
+    internal.Durations[timed % internal.Durations.size()] = std::chrono::duration<float, std::micro>(Clock::now() - start).count();
+    internal.Timed.store(timed + 1, std::memory_order_release);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::Run()
+{
+  Internals& internal = *this->Internal;
+  const Clock::duration period =
+    std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / this->Rate));
+  const Clock::duration spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(this->SpinTime));
+  const double nominal = 1e6 / this->Rate;
+  const double timeStep = 1.0 / this->Rate;
+  Clock::time_point deadline = Clock::now() + period;
+  Clock::time_point previousStart;
+  bool hasPrevious = false;
+  while (!internal.StopRequested.load(std::memory_order_acquire))
+  {
+    if (deadline - Clock::now() > spin)
+    {
+      std::this_thread::sleep_until(deadline - spin);
+    }
+    while (Clock::now() < deadline)
+    {
+      Relax();
+    }
+    const Clock::time_point start = Clock::now();
+    const size_t capacity = internal.Durations.size();
+    if (hasPrevious)
+    {
+      const unsigned long long jittered = internal.Jittered.load(std::memory_order_relaxed);
+      internal.Jitters[jittered % capacity] =
+        static_cast<float>(std::abs(std::chrono::duration<double, std::micro>(start - previousStart).count() - nominal));
+      internal.Jittered.store(jittered + 1, std::memory_order_release);
+    }
+    previousStart = start;
+    hasPrevious = true;
+    this->Tick(timeStep);
+    const Clock::time_point end = Clock::now();
+    const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
+    internal.Durations[timed % capacity] = std::chrono::duration<float, std::micro>(end - start).count();
+    internal.Timed.store(timed + 1, std::memory_order_release);
+    deadline += period;
+    if (end > deadline)
+    {
+      internal.Overruns.fetch_add(1, std::memory_order_relaxed);
+      // Late by more than a tick: start afresh rather than burst to catch up.
+      if (end > deadline + period)
+      {
+        deadline = end + period;
+      }
+    }
+  }
+  this->Finish();
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::SafeStop()
+{
+  Internals& internal = *this->Internal;
+  const unsigned long long tick = internal.TickCount.load(std::memory_order_relaxed);
+  if (internal.StrokeOpen && internal.Field)
+  {
+    // Everything cut so far stays, as one undo step.
+    internal.Field->EndStroke();
+    internal.Push(tick, DrillReleaseEvent);
+  }
+  internal.StrokeOpen = false;
+  internal.LastCutValid = false;
+  const double zero[3] = { 0.0, 0.0, 0.0 };
+  if (internal.Device)
+  {
+    internal.Device->SetForce(zero);
+  }
+  Display display{};
+  internal.Latest.Load(display);
+  std::fill(display.Force, display.Force + 3, 0.0);
+  display.Drilling = 0;
+  internal.Latest.Store(display);
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::Finish()
+{
+  this->SafeStop();
+  this->Internal->Running.store(false, std::memory_order_release);
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::Tick(double timeStep)
+{
+  Internals& internal = *this->Internal;
+  const unsigned long long tick = internal.TickCount.load(std::memory_order_relaxed);
+  internal.TickCount.store(tick + 1, std::memory_order_release);
+  vtkHapticDevice* device = internal.Device;
+  device->Synchronize(tick);
+  if (internal.Switch)
+  {
+    internal.Switch->Synchronize(tick);
+  }
+
+  vtkHapticDevice::Sample sample;
+  const bool connected = device->IsConnected();
+  const bool read = connected && device->GetLatestSample(sample);
+  bool present = read && sample.Present;
+  if (connected && !read && internal.HaveSample)
+  {
+    // The device's thread was caught publishing: this tick uses the last sample.
+    sample = internal.PreviousSample;
+    present = true;
+  }
+  vtkHapticRecorder::Tick record{};
+  record.Index = tick;
+  record.Present = present;
+  if (!present)
+  {
+    if (internal.WasPresent)
+    {
+      this->SafeStop();
+      internal.Push(tick, LostEvent);
+    }
+    internal.WasPresent = false;
+    internal.HaveSample = false;
+    if (internal.Recorder)
+    {
+      internal.Recorder->Record(record);
+    }
+    return;
+  }
+  if (!internal.WasPresent)
+  {
+    if (internal.EverPresent)
+    {
+      internal.Push(tick, ReturnEvent);
+    }
+    internal.EverPresent = internal.WasPresent = true;
+    internal.NeedsReset = true;
+  }
+  internal.HaveSample = true;
+  internal.PreviousSample = sample;
+
+  // The tool's pose in the scene.
+  const double (*m)[4] = internal.DeviceToRAS;
+  double position[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    position[row] = m[row][0] * sample.Position[0] + m[row][1] * sample.Position[1] + m[row][2] * sample.Position[2] + m[row][3];
+  }
+  double handle[3][3];
+  vtkMath::QuaternionToMatrix3x3(sample.Orientation, handle);
+  double turned[3][3];
+  double rotation[3][3];
+  vtkMath::Multiply3x3(internal.MapRotation, handle, turned);
+  vtkMath::Multiply3x3(turned, internal.ToolRotation, rotation);
+  if (internal.NeedsReset)
+  {
+    internal.Model->Reset(position);
+    internal.LastCutValid = false;
+    internal.NeedsReset = false;
+  }
+
+  unsigned int switchButtons = 0;
+  if (internal.Switch && internal.Switch->IsConnected())
+  {
+    vtkHapticDevice::Sample pedal;
+    if (internal.Switch->GetLatestSample(pedal) && pedal.Present)
+    {
+      switchButtons = pedal.Buttons;
+    }
+  }
+  const bool drilling = internal.Field && ((sample.Buttons | switchButtons) & this->DrillButtons) != 0;
+  if (drilling != internal.StrokeOpen)
+  {
+    if (drilling)
+    {
+      internal.Field->BeginStroke();
+      internal.Push(tick, DrillPressEvent);
+    }
+    else
+    {
+      internal.Field->EndStroke();
+      internal.Push(tick, DrillReleaseEvent);
+    }
+    internal.StrokeOpen = drilling;
+    internal.LastCutValid = false;
+  }
+
+  vtkHapticForceModel::Result result;
+  internal.Model->Update(position, rotation, timeStep, drilling, result);
+
+  bool cut = false;
+  if (drilling && result.Cut)
+  {
+    const double* p1 = result.CutPosition;
+    const double* p0 = internal.LastCutValid ? internal.LastCut : p1;
+    // A jump longer than the field accepts (the proxy is limited per tick,
+    // so only after a glitch) starts a new segment instead of an error here.
+    if (std::sqrt(vtkMath::Distance2BetweenPoints(p0, p1)) > internal.Field->GetMaximumStrokeLength())
+    {
+      p0 = p1;
+    }
+    if (internal.Tool)
+    {
+      const double (*r0)[3] = internal.LastCutValid ? internal.LastCutRotation : rotation;
+      for (int row = 0; row < 3; ++row)
+      {
+        for (int column = 0; column < 3; ++column)
+        {
+          internal.Pose0->SetElement(row, column, r0[row][column]);
+          internal.Pose1->SetElement(row, column, rotation[row][column]);
+        }
+        internal.Pose0->SetElement(row, 3, p0[row]);
+        internal.Pose1->SetElement(row, 3, p1[row]);
+      }
+      cut = internal.Field->CutToolSweep(internal.Tool, internal.Pose0, internal.Pose1);
+    }
+    else
+    {
+      cut = internal.Field->CutCapsule(p0, p1, internal.Radius);
+    }
+    internal.Push(tick, cut ? CutEvent : FailedCutEvent, p0, p1);
+    if (cut)
+    {
+      std::copy(p1, p1 + 3, internal.LastCut);
+      std::copy(&rotation[0][0], &rotation[0][0] + 9, &internal.LastCutRotation[0][0]);
+    }
+  }
+  internal.LastCutValid = cut;
+
+  // The force in the device's frame (forces do not scale with positions).
+  double force[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    force[row] = internal.MapRotation[0][row] * result.Force[0] + internal.MapRotation[1][row] * result.Force[1] +
+      internal.MapRotation[2][row] * result.Force[2];
+  }
+  device->SetForce(force);
+  double sent[3];
+  device->GetCommandedForce(sent);
+
+  Display display;
+  for (int row = 0; row < 3; ++row)
+  {
+    for (int column = 0; column < 3; ++column)
+    {
+      display.ToolToRAS[4 * row + column] = rotation[row][column];
+    }
+    display.ToolToRAS[4 * row + 3] = result.ProxyPosition[row];
+  }
+  display.ToolToRAS[12] = display.ToolToRAS[13] = display.ToolToRAS[14] = 0.0;
+  display.ToolToRAS[15] = 1.0;
+  std::copy(sent, sent + 3, display.Force);
+  display.Drilling = drilling ? 1 : 0;
+  display.ContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
+  internal.Latest.Store(display);
+
+  if (internal.Recorder)
+  {
+    std::copy(sample.Position, sample.Position + 3, record.Position);
+    std::copy(sample.Orientation, sample.Orientation + 4, record.Orientation);
+    record.Buttons = sample.Buttons;
+    record.SwitchButtons = switchButtons;
+    std::copy(sent, sent + 3, record.Force);
+    std::copy(result.ProxyPosition, result.ProxyPosition + 3, record.Proxy);
+    record.Drilling = drilling;
+    record.Cut = cut;
+    internal.Recorder->Record(record);
+  }
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::GetLatestToolPose(vtkMatrix4x4* toolToRAS) const
+{
+  Display display;
+  if (!toolToRAS || !this->Internal->Latest.Load(display))
+  {
+    return false;
+  }
+  toolToRAS->DeepCopy(display.ToolToRAS);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::GetLatestForce(double force[3]) const
+{
+  Display display{};
+  this->Internal->Latest.Load(display);
+  std::copy(display.Force, display.Force + 3, force);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::GetDrilling() const
+{
+  Display display{};
+  this->Internal->Latest.Load(display);
+  return display.Drilling != 0;
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetLatestContactDepth() const
+{
+  Display display{};
+  this->Internal->Latest.Load(display);
+  return display.ContactDepth;
+}
+
+//------------------------------------------------------------------------------
+int vtkHapticLoop::ProcessEvents()
+{
+  Internals& internal = *this->Internal;
+  int cuts = 0;
+  Event event;
+  while (internal.Events.Pop(event))
+  {
+    switch (event.Type)
+    {
+      case CutEvent:
+        ++cuts;
+        std::copy(event.P0, event.P0 + 3, internal.LastSegment[0]);
+        std::copy(event.P1, event.P1 + 3, internal.LastSegment[1]);
+        break;
+      case DrillPressEvent:
+        ++this->NumberOfDrillPresses;
+        break;
+      case DrillReleaseEvent:
+        ++this->NumberOfDrillReleases;
+        break;
+      case LostEvent:
+        ++this->NumberOfDeviceLosses;
+        break;
+      case ReturnEvent:
+        ++this->NumberOfDeviceReturns;
+        break;
+      case FailedCutEvent:
+        ++this->NumberOfFailedCuts;
+        break;
+      default:
+        break;
+    }
+  }
+  this->NumberOfCutStrokes += cuts;
+  const int dropped = internal.DroppedEvents.exchange(0, std::memory_order_relaxed);
+  if (dropped > 0)
+  {
+    this->NumberOfDroppedEvents += dropped;
+    vtkWarningMacro("ProcessEvents: " << dropped << " reports of the haptic thread did not fit its queue (call ProcessEvents more often)");
+  }
+  return cuts;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::GetLastCutSegment(double p0[3], double p1[3]) const
+{
+  std::copy(this->Internal->LastSegment[0], this->Internal->LastSegment[0] + 3, p0);
+  std::copy(this->Internal->LastSegment[1], this->Internal->LastSegment[1] + 3, p1);
+}
+
+//------------------------------------------------------------------------------
+unsigned long long vtkHapticLoop::GetNumberOfTicks() const
+{
+  return this->Internal->TickCount.load(std::memory_order_acquire);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetTickDurationPercentile(double percent) const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.Durations.size());
+  return Percentile(std::vector<float>(internal.Durations.begin(), internal.Durations.begin() + count), percent);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetMaximumTickDuration() const
+{
+  return this->GetTickDurationPercentile(100.0);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetPeriodJitterPercentile(double percent) const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Jittered.load(std::memory_order_acquire), internal.Jitters.size());
+  return Percentile(std::vector<float>(internal.Jitters.begin(), internal.Jitters.begin() + count), percent);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetMaximumPeriodJitter() const
+{
+  return this->GetPeriodJitterPercentile(100.0);
+}
+
+//------------------------------------------------------------------------------
+unsigned long long vtkHapticLoop::GetNumberOfOverruns() const
+{
+  return this->Internal->Overruns.load(std::memory_order_acquire);
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::GetRealTimePriority() const
+{
+  return this->Internal->RealTime;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::ResetStatistics()
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("ResetStatistics: stop the loop first");
+    return;
+  }
+  this->Internal->Timed = 0;
+  this->Internal->Jittered = 0;
+  this->Internal->Overruns = 0;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticLoop::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "Rate: " << this->Rate << " Hz\n";
+  os << indent << "DrillButtons: " << this->DrillButtons << "\n";
+  os << indent << "SpinTime: " << this->SpinTime << " s\n";
+  os << indent << "ProcessorIndex: " << this->ProcessorIndex << "\n";
+  os << indent << "StatisticsCapacity: " << this->StatisticsCapacity << "\n";
+  os << indent << "Running: " << (this->IsRunning() ? "yes" : "no") << "\n";
+  os << indent << "NumberOfTicks: " << this->GetNumberOfTicks() << "\n";
+  os << indent << "NumberOfCutStrokes: " << this->NumberOfCutStrokes << "\n";
+  os << indent << "DeviceScale: " << this->GetDeviceScale() << "\n";
+}

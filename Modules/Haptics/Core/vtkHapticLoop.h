@@ -1,0 +1,254 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+/**
+ * @class   vtkHapticLoop
+ * @brief   The haptic thread: device in, force out, cut strokes through the field.
+ *
+ * Start runs a thread that ticks at Rate (1 kHz by default, up to 4 kHz,
+ * seed 003). Each tick it reads the device's latest sample (and the foot
+ * switch's), maps it into the scene (DeviceToRAS), lets the force model
+ * (vtkHapticForceModel) find the proxy, the force and the cut, cuts the
+ * field along the way from the last cut (the tool's sweep, one undo step
+ * per press of the drill), and sends the force.
+ *
+ * Real-time path: no allocation, no lock, nothing shared with the renderer
+ * or MRML but lock-free exchanges. The tick reads devices through their
+ * sequence locks; it publishes the tool's pose and force through one for
+ * the display, and its cut strokes, drill presses and device losses
+ * through a single-producer single-consumer ring that the main thread
+ * drains at display rate (ProcessEvents). While it runs, the haptic thread
+ * is the cut field's single writer (readers, the renderers, read as they
+ * like); the application must not cut, undo or restore meanwhile. The cut
+ * field's writer itself allocates a brick the first time a tool reaches it
+ * and copies a brick once per stroke for undo; everything else in the tick
+ * is allocated by Start.
+ *
+ * Safety. A device that is lost (unplugged, silent) or gives no sample
+ * stops the drill at once: the open stroke is closed (every cut made stays,
+ * as one undo step), the force is zero. When the device is back the proxy
+ * starts again where the hand is, without sweeping from where it left.
+ *
+ * Timing. Ticks are scheduled on absolute deadlines; the thread sleeps to
+ * SpinTime before each deadline and waits the rest actively, which keeps
+ * the period's jitter well below 0.1 ms on an idle core. It asks for
+ * real-time priority and, if ProcessorIndex is set, for one processor;
+ * either may be refused (see GetRealTimePriority). Tick durations and
+ * periods are kept for the last StatisticsCapacity ticks.
+ *
+ * RunTicks performs the same ticks on the calling thread without waiting
+ * between them, for deterministic replays (vtkReplayHapticDevice) and tests.
+ *
+ * @sa vtkHapticDevice vtkHapticForceModel vtkHapticRecorder
+ */
+
+#ifndef vtkHapticLoop_h
+#define vtkHapticLoop_h
+
+#include "vtkObject.h"
+#include "vtkSmartPointer.h"               // For the parts
+#include "vtkVolumeCuttingHapticsExport.h" // For export macro
+
+#include <memory> // For the internals
+
+class vtkHapticDevice;
+class vtkHapticForceModel;
+class vtkHapticRecorder;
+class vtkMatrix4x4;
+class vtkVolumeCutField;
+class vtkVolumeCutTool;
+
+class VTK_VOLUMECUTTINGHAPTICS_EXPORT vtkHapticLoop : public vtkObject
+{
+public:
+  static vtkHapticLoop* New();
+  vtkTypeMacro(vtkHapticLoop, vtkObject);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+
+  ///@{
+  /**
+   * The parts, set while the loop is stopped: the device that moves the
+   * tool, an optional second device whose buttons also run the drill (a
+   * foot switch), the force model, the field that strokes cut (nullptr: no
+   * cutting) and an optional recorder.
+   */
+  void SetDevice(vtkHapticDevice* device);
+  vtkHapticDevice* GetDevice();
+  void SetSwitchDevice(vtkHapticDevice* device);
+  vtkHapticDevice* GetSwitchDevice();
+  void SetForceModel(vtkHapticForceModel* model);
+  vtkHapticForceModel* GetForceModel();
+  void SetCutField(vtkVolumeCutField* field);
+  vtkVolumeCutField* GetCutField();
+  void SetRecorder(vtkHapticRecorder* recorder);
+  vtkHapticRecorder* GetRecorder();
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the tick rate (Hz), 1 to 4000. Default is 1000.
+   */
+  vtkSetClampMacro(Rate, double, 1.0, 4000.0);
+  vtkGetMacro(Rate, double);
+  ///@}
+
+  /**
+   * The device's frame in the scene: a rotation, a uniform scale (scene mm
+   * per device mm) and a translation. Refused (false, with an error) if it
+   * is not such a matrix. Default is the identity.
+   */
+  bool SetDeviceToRAS(vtkMatrix4x4* deviceToRAS);
+  void GetDeviceToRAS(vtkMatrix4x4* deviceToRAS);
+
+  /// The scale of DeviceToRAS.
+  double GetDeviceScale() const;
+
+  /**
+   * The tool's orientation in the handle's frame: the tool-to-RAS rotation
+   * is DeviceToRAS's rotation times the handle's orientation times this
+   * (for devices that sense no rotation, the handle's is the identity).
+   * Default is the identity.
+   */
+  void SetToolRotation(vtkMatrix4x4* rotation);
+
+  ///@{
+  /**
+   * Set/get the buttons (a bit mask) of either device that run the drill. Default is 1.
+   */
+  vtkSetMacro(DrillButtons, unsigned int);
+  vtkGetMacro(DrillButtons, unsigned int);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the time (s) before each tick that the thread waits actively
+   * instead of sleeping. Default is 0.0002.
+   */
+  vtkSetClampMacro(SpinTime, double, 0.0, 0.01);
+  vtkGetMacro(SpinTime, double);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the processor the thread asks to run on (-1: any). Default is -1.
+   */
+  vtkSetMacro(ProcessorIndex, int);
+  vtkGetMacro(ProcessorIndex, int);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get how many ticks' durations and periods are kept (memory taken at Start). Default is 100000.
+   */
+  vtkSetClampMacro(StatisticsCapacity, int, 16, 100000000);
+  vtkGetMacro(StatisticsCapacity, int);
+  ///@}
+
+  /**
+   * Check the parts (an open device, a force model that prepares), take the
+   * memory the ticks need and start the thread. False, with an error
+   * saying what is missing, otherwise.
+   */
+  bool Start();
+
+  /// Stop the thread; the open stroke is closed on it, the force set to zero.
+  void Stop();
+
+  bool IsRunning() const;
+
+  /**
+   * Run count ticks on the calling thread, back to back (time step 1 /
+   * Rate): deterministic replays and tests. Not while the thread runs.
+   * The first call prepares as Start does; Stop ends the session.
+   */
+  bool RunTicks(int count);
+
+  ///@{
+  /**
+   * The display side, for the main thread at display rate, lock-free: the
+   * tool's latest pose (tool-to-RAS, the proxy's), the force sent (N,
+   * device frame), whether the drill runs.
+   */
+  bool GetLatestToolPose(vtkMatrix4x4* toolToRAS) const;
+  void GetLatestForce(double force[3]) const;
+  bool GetDrilling() const;
+  ///@}
+
+  /**
+   * The cut field's deepest contact with a protected structure (mm) as the
+   * haptic thread last read it, after its cuts: the main thread must not
+   * read the field's contact record while the loop writes it.
+   */
+  double GetLatestContactDepth() const;
+
+  /**
+   * Drain what the haptic thread reported since the last call (cut strokes,
+   * drill presses and releases, device losses and returns, failed cuts) into
+   * the counters below; returns the number of cut strokes among them. Main thread.
+   */
+  int ProcessEvents();
+
+  ///@{
+  /**
+   * Counts since Start, as drained by ProcessEvents.
+   */
+  vtkGetMacro(NumberOfCutStrokes, int);
+  vtkGetMacro(NumberOfDrillPresses, int);
+  vtkGetMacro(NumberOfDrillReleases, int);
+  vtkGetMacro(NumberOfDeviceLosses, int);
+  vtkGetMacro(NumberOfDeviceReturns, int);
+  vtkGetMacro(NumberOfFailedCuts, int);
+  vtkGetMacro(NumberOfDroppedEvents, int);
+  ///@}
+
+  /// The last stroke segment cut (RAS, tool centres), valid after ProcessEvents counted one.
+  void GetLastCutSegment(double p0[3], double p1[3]) const;
+
+  ///@{
+  /**
+   * Timing of the ticks kept (see StatisticsCapacity), in microseconds:
+   * percentiles (0-100) and maximum of a tick's duration and of the
+   * deviation of the period from 1 / Rate; ticks whose work took longer
+   * than a period. Read them while stopped.
+   */
+  unsigned long long GetNumberOfTicks() const;
+  double GetTickDurationPercentile(double percent) const;
+  double GetMaximumTickDuration() const;
+  double GetPeriodJitterPercentile(double percent) const;
+  double GetMaximumPeriodJitter() const;
+  unsigned long long GetNumberOfOverruns() const;
+  bool GetRealTimePriority() const;
+  void ResetStatistics();
+  ///@}
+
+protected:
+  vtkHapticLoop();
+  ~vtkHapticLoop() override;
+
+  bool Prepare();
+  void Run();
+  void Tick(double timeStep);
+  void SafeStop();
+  void Finish();
+
+  double Rate = 1000.0;
+  unsigned int DrillButtons = 1u;
+  double SpinTime = 0.0002;
+  int ProcessorIndex = -1;
+  int StatisticsCapacity = 100000;
+  int NumberOfCutStrokes = 0;
+  int NumberOfDrillPresses = 0;
+  int NumberOfDrillReleases = 0;
+  int NumberOfDeviceLosses = 0;
+  int NumberOfDeviceReturns = 0;
+  int NumberOfFailedCuts = 0;
+  int NumberOfDroppedEvents = 0;
+
+  struct Internals;
+  std::unique_ptr<Internals> Internal;
+
+private:
+  vtkHapticLoop(const vtkHapticLoop&) = delete;
+  void operator=(const vtkHapticLoop&) = delete;
+};
+
+#endif

@@ -1,0 +1,129 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+// The haptic loop's threads, also run under ThreadSanitizer: the loop's
+// thread drills the field while a hand thread pushes device poses, a
+// renderer thread reads the field (bricks, distances, stamps) and the main
+// thread reads the display side and drains the loop's reports, then
+// unplugs and replugs the device. With cuts only, no stored sample may ever
+// grow, and no copy may be torn.
+#include "vtkHapticTestScene.h"
+
+#include "vtkHapticForceModel.h"
+#include "vtkHapticLoop.h"
+#include "vtkVirtualHapticDevice.h"
+
+#include <vtkAddonTestingMacros.h>
+
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
+{
+  vtkHapticTestScene scene;
+  vtkNew<vtkVirtualHapticDevice> device;
+  device->SetReconnectInterval(0.0);
+  vtkNew<vtkHapticForceModel> model;
+  model->SetAnatomy(scene.CT, scene.IJKToRAS);
+  model->SetSurfaceIsoValue(scene.IsoValue);
+  model->SetSphereRadius(2.0);
+  vtkNew<vtkHapticLoop> loop;
+  loop->SetDevice(device);
+  loop->SetForceModel(model);
+  loop->SetCutField(scene.Field);
+  vtkNew<vtkMatrix4x4> deviceToRAS;
+  deviceToRAS->SetElement(2, 3, scene.PlaneHeight + 3.0);
+  loop->SetDeviceToRAS(deviceToRAS);
+  CHECK_BOOL(device->Open(), true);
+  const double start[3] = { 0.0, 0.0, 0.0 };
+  device->SetPose(start, 0u);
+  CHECK_BOOL(loop->Start(), true);
+
+  std::atomic<bool> done{ false };
+  // The hand: down into the bone with the drill on, circling.
+  std::thread hand([&]() {
+    for (int step = 0; !done.load(); ++step)
+    {
+      const double angle = 0.01 * step;
+      const double position[3] = { 3.0 * std::cos(angle), 3.0 * std::sin(angle), -std::min(2.5, 0.005 * step) };
+      device->SetPose(position, 1u);
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  });
+  // The renderer: reads every allocated brick again and again.
+  std::atomic<bool> consistent{ true };
+  std::atomic<long> reads{ 0 };
+  std::thread renderer([&]() {
+    const int* dims = scene.Field->GetBrickDimensions();
+    const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+    std::vector<short> previous(static_cast<size_t>(count) * 512, 32767);
+    std::vector<short> current(512);
+    while (!done.load())
+    {
+      for (vtkIdType id = 0; id < count; ++id)
+      {
+        scene.Field->CopyBrick(id, current.data());
+        short* before = &previous[static_cast<size_t>(id) * 512];
+        for (int n = 0; n < 512; ++n)
+        {
+          if (current[n] > before[n])
+          {
+            consistent = false;
+          }
+          before[n] = current[n];
+        }
+      }
+      const double probe[3] = { 3.0, 0.0, scene.PlaneHeight - 0.2 };
+      scene.Field->GetSignedDistance(probe);
+      scene.Field->GetCurrentStamp();
+      ++reads;
+    }
+  });
+
+  // The main thread at display rate.
+  vtkNew<vtkMatrix4x4> pose;
+  int cuts = 0;
+  // The lost device is reported (a warning) on the main thread.
+  TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
+  for (int frame = 0; frame < 40; ++frame)
+  {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    loop->GetLatestToolPose(pose);
+    double force[3];
+    loop->GetLatestForce(force);
+    // The contact depth as the haptic thread last read it from the field it writes.
+    CHECK_BOOL(loop->GetLatestContactDepth() >= 0.0, true);
+    cuts += loop->ProcessEvents();
+    device->ProcessConnectionEvents();
+    if (frame == 20)
+    {
+      device->SetPlugged(false);
+    }
+    if (frame == 25)
+    {
+      device->SetPlugged(true);
+    }
+  }
+  TESTING_OUTPUT_ASSERT_WARNINGS_END();
+  done = true;
+  hand.join();
+  renderer.join();
+  loop->Stop();
+  cuts += loop->ProcessEvents();
+  std::cout << loop->GetNumberOfTicks() << " ticks, " << cuts << " cut strokes, " << reads.load() << " passes over the field by the reader"
+            << std::endl;
+  CHECK_BOOL(consistent.load(), true);
+  CHECK_BOOL(cuts > 0, true);
+  CHECK_BOOL(reads.load() > 0, true);
+  CHECK_INT(loop->GetNumberOfDeviceLosses(), 1);
+  CHECK_BOOL(device->IsConnected(), true);
+  CHECK_BOOL(scene.Field->IsStrokeOpen(), false);
+  return EXIT_SUCCESS;
+}
