@@ -128,6 +128,35 @@ def path_allowed(path: Path, folders) -> bool:
     return any(resolved == folder or folder in resolved.parents for folder in folders)
 
 
+def unpack_upload(written: list[Path], folder: Path, max_bytes: int) -> Path:
+    """The path to load from uploaded files: the file, the folder of a series, or what a .zip holds.
+
+    A .zip is unpacked into ``folder``/unpacked, refusing members that would
+    land outside it and contents larger than ``max_bytes``.
+    """
+    if len(written) == 1 and written[0].suffix.lower() == ".zip":
+        archive = written[0]
+        with zipfile.ZipFile(archive) as bundle:
+            members = [member for member in bundle.infolist() if not member.is_dir()]
+            size = sum(member.file_size for member in members)
+            if size > max_bytes:
+                raise SessionError(f"{archive.name}: unpacked it holds {size / 2**20:.1f} MB, more than this server "
+                                   f"accepts ({max_bytes / 2**20:.1f} MB)")
+            target = (folder / "unpacked").resolve()
+            for member in members:
+                destination = (target / member.filename).resolve()
+                if target not in destination.parents:
+                    raise SessionError(f"{archive.name}: holds a path outside its folder ({member.filename}); not unpacked")
+            for member in members:
+                destination = target / member.filename
+                destination.parent.mkdir(parents=True, exist_ok=True)
+                destination.write_bytes(bundle.read(member))
+        archive.unlink()
+        unpacked = [path for path in target.rglob("*") if path.is_file()]
+        return unpacked[0] if len(unpacked) == 1 else target
+    return written[0] if len(written) == 1 else folder
+
+
 class ConnectionWatch(LinkProtocol):
     """Tells the application when a browser tab connects or goes away (closed, reloaded, network lost)."""
 
@@ -165,6 +194,7 @@ class VolumeCuttingApp(TrameApp):
         self._contact_observer = None
         self._observed_cut_node = None
         self._clients: list[str] = []
+        self._upload_names: dict[str, str] = {}
         self._last_table_refresh = 0.0
         self._table_refresh_task = None
         self.progressive = None
@@ -362,8 +392,7 @@ class VolumeCuttingApp(TrameApp):
             return
         self.state.vc_contact = (f"Contact with {contact.name} ({'protected' if self.session.cut_node.IsSegmentProtected(contact.segment_id) else 'not cuttable by this tool'}): "
                                  f"{contact.depth_mm:.2f} mm deep")
-        for pipeline in self.drill.pipelines:
-            pipeline.set_contact(True)
+        self.drill.set_glyph(in_contact=True)
         self.state.flush()
 
     # ------------------------------------------------------------------ drilling callbacks
@@ -371,8 +400,7 @@ class VolumeCuttingApp(TrameApp):
     def _on_stroke_begin(self) -> None:
         self.progressive.stroke_started()
         self.state.vc_contact = ""
-        for pipeline in self.drill.pipelines:
-            pipeline.set_contact(False)
+        self.drill.set_glyph(in_contact=False)
 
     def _on_stroke_moved(self) -> None:
         # The removed volume follows live, a few times a second.
@@ -382,6 +410,26 @@ class VolumeCuttingApp(TrameApp):
 
     def _on_stroke_end(self) -> None:
         self.progressive.stroke_ended()
+        self._refresh_tables()
+        self._jump_slices_to_tool()
+
+    def _jump_slices_to_tool(self) -> None:
+        """The slice views go through the tool's centre, where the cut was just made."""
+        transform = self.session.tool_node.GetParentTransformNode() if self.session.has_data else None
+        if transform is None:
+            return
+        pose = vtk.vtkMatrix4x4()
+        transform.GetMatrixTransformToWorld(pose)
+        slicer.vtkMRMLSliceNode.JumpAllSlices(self.slicer_app.scene, pose.GetElement(0, 3), pose.GetElement(1, 3),
+                                              pose.GetElement(2, 3), slicer.vtkMRMLSliceNode.OffsetJumpSlice)
+
+    def _undo_redo(self, step) -> None:
+        """Undo or redo a stroke; a contact warning belonged to the stroke that was drawn last."""
+        if not self.session.has_data:
+            return
+        step()
+        self.state.vc_contact = ""
+        self.drill.set_glyph(in_contact=False)
         self._refresh_tables()
 
     def _on_depth_changed(self, depth: float) -> None:
@@ -440,9 +488,10 @@ class VolumeCuttingApp(TrameApp):
             self._clients.insert(0, sender)
             self._publish_owner()
 
-        @ctrl.trigger("vc_timing_log")
-        def timing_log():
-            return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"])}
+        @ctrl.trigger("vc_diagnostics")
+        def diagnostics():
+            # For tests and benchmarks: what the server did and which mode it is in.
+            return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]), "mode": self.drill.mode}
 
         @ctrl.trigger("vc_load")
         async def load(source):
@@ -481,15 +530,11 @@ class VolumeCuttingApp(TrameApp):
 
         @ctrl.trigger("vc_undo")
         def undo():
-            if self.session.has_data:
-                self.session.undo()
-                self._refresh_tables()
+            self._undo_redo(self.session.undo)
 
         @ctrl.trigger("vc_redo")
         def redo():
-            if self.session.has_data:
-                self.session.redo()
-                self._refresh_tables()
+            self._undo_redo(self.session.redo)
 
         @ctrl.trigger("vc_export")
         def export(kind):
@@ -547,11 +592,17 @@ class VolumeCuttingApp(TrameApp):
             self._refresh_after_data()
             state.vc_status = "Ready: " + self.session.description
         except (SessionError, owndata.InputError, headct.HeadCTUnavailableError, OSError) as error:
-            state.vc_error = str(error)
+            state.vc_error = self._with_upload_names(str(error))
             state.vc_status = "Not loaded; the previous data stays" if self.session.has_data else "Not loaded"
         finally:
             with state:
                 state.vc_busy = False
+
+    def _with_upload_names(self, text: str) -> str:
+        """Messages name uploaded files as the user named them, not by where the server keeps them."""
+        for path, name in sorted(self._upload_names.items(), key=lambda item: -len(item[0])):
+            text = text.replace(path, f"{name} (uploaded)")
+        return text
 
     def _own_data_paths(self) -> dict:
         """The CT and segmentation to load: the uploaded ones, else the server paths (checked against the allowed folders)."""
@@ -599,40 +650,16 @@ class VolumeCuttingApp(TrameApp):
             path.write_bytes(item.get("content") or b"")
             written.append(path)
         try:
-            target = self._unpack(written, folder)
+            target = unpack_upload(written, folder, self.options.max_upload_bytes)
         except (zipfile.BadZipFile, SessionError) as error:
             state.vc_upload_message = str(error)
             return
+        names = [Path(str(item.get("name") or "upload")).name for item in files]
+        self._upload_names[str(target)] = names[0] if len(names) == 1 else f"{len(names)} files ({names[0]}, ...)"
         uploaded = dict(state.vc_uploaded or {})
         uploaded[kind] = str(target)
         state.vc_uploaded = uploaded
         state.vc_upload_message = ""
-
-    def _unpack(self, written: list[Path], folder: Path) -> Path:
-        """The path to load: the file, the folder of a series, or what a .zip holds."""
-        if len(written) == 1 and written[0].suffix.lower() == ".zip":
-            archive = written[0]
-            with zipfile.ZipFile(archive) as bundle:
-                members = [m for m in bundle.infolist() if not m.is_dir()]
-                size = sum(m.file_size for m in members)
-                if size > self.options.max_upload_bytes:
-                    raise SessionError(f"{archive.name}: unpacked it holds {size / 2**20:.1f} MB, more than this server "
-                                       f"accepts ({self.options.max_upload_mb:.1f} MB)")
-                target = folder / "unpacked"
-                for member in members:
-                    destination = (target / member.filename).resolve()
-                    if target.resolve() not in destination.parents:
-                        raise SessionError(f"{archive.name}: holds a path outside its folder ({member.filename}); not unpacked")
-                    destination.parent.mkdir(parents=True, exist_ok=True)
-                    destination.write_bytes(bundle.read(member))
-            archive.unlink()
-            unpacked = [p for p in target.rglob("*") if p.is_file()]
-            if len(unpacked) == 1:
-                return unpacked[0]
-            return target
-        if len(written) == 1:
-            return written[0]
-        return folder
 
     # ------------------------------------------------------------------ page
 
@@ -712,22 +739,24 @@ class VolumeCuttingApp(TrameApp):
 
     def _segments_panel(self) -> None:
         with v3.VExpansionPanel(value="segments", title="Segments"), v3.VExpansionPanelText():
-            with v3.VTable(density="compact", raw_attrs=['data-testid="segments"']):
+            with v3.VTable(density="compact", raw_attrs=['data-testid="segments"'], style="font-size: 13px"):
                 with html.Thead(), html.Tr():
-                    html.Th("")
-                    html.Th("Segment")
-                    html.Th("Role")
-                    html.Th("Removed (mm³)", classes="text-right")
+                    html.Th("Segment", style="padding: 0 4px")
+                    html.Th("Role", style="padding: 0 4px")
+                    html.Th("Removed mm³", classes="text-right", style="padding: 0 4px")
                 with html.Tbody():
                     with html.Tr(v_for="s in vc_segments", key="s.id", raw_attrs=[':data-segment="s.id"']):
-                        with html.Td():
-                            html.Div(style=("{ width: '14px', height: '14px', borderRadius: '3px', background: s.color }",))
-                        html.Td("{{ s.name }}", classes="text-body-2")
-                        with html.Td(style="min-width: 120px"):
+                        with html.Td(style="padding: 0 4px; word-break: break-word"):
+                            html.Span(style=("{ display: 'inline-block', width: '10px', height: '10px', marginRight: '6px', "
+                                             "borderRadius: '2px', background: s.color }",))
+                            html.Span("{{ s.name }}")
+                        with html.Td(style="padding: 0 4px; width: 112px"):
                             v3.VSelect(model_value=("s.role",), items=("vc_role_items",), density="compact",
                                        variant="plain", hide_details=True, raw_attrs=[':data-role-of="s.id"'],
+                                       style="font-size: 13px",
                                        update_modelValue="trigger('vc_set_role', [s.id, $event])")
-                        html.Td("{{ s.removed.toFixed(2) }}", classes="text-right", raw_attrs=[':data-removed-of="s.id"'])
+                        html.Td("{{ s.removed.toFixed(2) }}", classes="text-right", style="padding: 0 4px",
+                                raw_attrs=[':data-removed-of="s.id"'])
             html.Div("Removed in all: {{ vc_total_removed.toFixed(2) }} mm³", classes="text-body-2 mt-1",
                      raw_attrs=['data-testid="total-removed"'])
 

@@ -47,13 +47,17 @@ TIMING_HOOK = """
       x: e.clientX, y: e.clientY, buttons: e.buttons }), true);
   }
   // A frame is shown when an image element takes its URL (the viewer swaps images once one has loaded).
+  const displayed = new Map(); // object URL -> time it was ready on screen
+  function showing(url, time) {
+    const record = pending.get(url);
+    if (record) { record.shown = time; pending.delete(url); } else { displayed.set(url, time); }
+  }
   new MutationObserver((mutations) => {
     for (const m of mutations) {
-      const record = m.target.tagName === "IMG" && pending.get(m.target.getAttribute("src"));
-      if (!record) continue;
-      pending.delete(m.target.getAttribute("src"));
-      m.target.decode().then(() => requestAnimationFrame(() => { record.shown = now(); }),
-                             () => requestAnimationFrame(() => { record.shown = now(); }));
+      if (m.target.tagName !== "IMG") continue;
+      const url = m.target.getAttribute("src");
+      const done = () => requestAnimationFrame(() => showing(url, now()));
+      m.target.decode().then(done, done);
     }
   }).observe(document, { subtree: true, attributes: true, attributeFilter: ["src"] });
   function hook() {
@@ -66,8 +70,12 @@ TIMING_HOOK = """
                        arrived: now(), shown: null };
       vc.frames.push(record);
       const before = lastUrl;
-      // After the viewer's own handler, which made the image's object URL.
-      setTimeout(() => { if (lastUrl && lastUrl !== before) pending.set(lastUrl, record); }, 0);
+      // The viewer's own handler makes the image's object URL in the same dispatch, before or after this one.
+      queueMicrotask(() => {
+        if (!lastUrl || lastUrl === before) return;
+        if (displayed.has(lastUrl)) { record.shown = displayed.get(lastUrl); displayed.delete(lastUrl); }
+        else pending.set(lastUrl, record);
+      });
     });
   }
   hook();
@@ -117,6 +125,9 @@ class AppServer:
         self.start_timeout_s = start_timeout_s
         self.env = dict(os.environ, **(env or {}))
         self.env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+        # The server runs the same VolumeCuttingLib as the caller (the installed one, or a source tree).
+        library_root = str(Path(__file__).resolve().parents[2])
+        self.env["PYTHONPATH"] = os.pathsep.join(p for p in (library_root, self.env.get("PYTHONPATH", "")) if p)
         self.process = None
         self.started_at = None
 
@@ -185,9 +196,9 @@ class AppPage:
         return self.page.locator(f'[data-testid="{name}"]')
 
     def wait_ready(self, timeout_s: float = 60.0) -> None:
-        """Until the status says the data is ready and the 3D view shows an image."""
-        self.page.wait_for_function("() => document.querySelector('[data-testid=status]')?.textContent.includes('Ready')",
-                                    timeout=timeout_s * 1000)
+        """Until data is loaded (nothing loading) and the 3D view shows an image."""
+        self.wait_for("() => { const s = window.trame?.state; return !!s && !s.get('vc_busy') && !!s.get('vc_description'); }",
+                      timeout_s, "the data to be loaded")
         self.wait_for_view_image(timeout_s)
 
     def wait_for_view_image(self, timeout_s: float = 60.0) -> None:
@@ -203,10 +214,11 @@ class AppPage:
             raise BrowserTestError("The 3D view is not on the page")
         return box
 
-    def set_mode(self, mode: str) -> None:
+    def set_mode(self, mode: str, timeout_s: float = 60.0) -> None:
+        """Click a mode button and wait until the server drills (or navigates) in that mode."""
         self.testid(f"mode-{mode}").click()
-        self.page.wait_for_function(f"() => document.querySelector('[data-testid=mode-{mode}]')"
-                                    ".classList.contains('v-btn--active')", timeout=10000)
+        self.wait_for(f"async () => (await window.trame.trigger('vc_diagnostics')).mode === '{mode}'", timeout_s,
+                      f"the server to switch to {mode} mode")
 
     def drag(self, points, step_delay_ms: float = 16.0, shift: bool = False) -> None:
         """Press at the first point (page pixels), move through the others, release at the last."""
@@ -249,7 +261,7 @@ class AppPage:
         the server is not in the middle of drawing.
         """
         deadline = time.monotonic() + timeout_s
-        script = f"""async () => {{ await window.trame.trigger('vc_timing_log');
+        script = f"""async () => {{ await window.trame.trigger('vc_diagnostics');
                              const f = (window.__vcTiming?.frames || []);
                              const last = f.length ? f[f.length - 1].arrived : 0;
                              return performance.timeOrigin + performance.now() - last > {quiet_ms}; }}"""
@@ -258,6 +270,22 @@ class AppPage:
                 return
             self.page.wait_for_timeout(min(quiet_ms, 500))
         raise BrowserTestError(f"The 3D view kept changing for {timeout_s:.0f} s")
+
+    def wait_refined(self, quiet_ms: float = 1000.0, timeout_s: float = 60.0) -> None:
+        """Until the 3D view shows a full-resolution frame and stays still (needs the timing hook)."""
+        area = self.three_d_area()
+        width = self.three_d_box()["width"]
+        deadline = time.monotonic() + timeout_s
+        script = f"""async () => {{ await window.trame.trigger('vc_diagnostics');
+                             const f = (window.__vcTiming?.frames || []).filter(f => f.name === '{area}');
+                             const last = f.length ? f[f.length - 1] : null;
+                             return !!last && last.w >= {0.9 * width} && last.shown > 0 &&
+                                    performance.timeOrigin + performance.now() - last.arrived > {quiet_ms}; }}"""
+        while time.monotonic() < deadline:
+            if self.page.evaluate(script):
+                return
+            self.page.wait_for_timeout(200)
+        raise BrowserTestError(f"The 3D view did not come to rest at full resolution within {timeout_s:.0f} s")
 
     def settle(self, quiet_ms: float = 1000.0, timeout_s: float = 30.0) -> None:
         """Until the 3D view's image stayed the same for ``quiet_ms`` (no timing hook needed)."""
@@ -301,7 +329,7 @@ class AppPage:
         return self.page.evaluate("() => window.__vcTiming")
 
     def server_timing(self) -> dict:
-        return self.page.evaluate("() => window.trame.trigger('vc_timing_log')")
+        return self.page.evaluate("() => window.trame.trigger('vc_diagnostics')")
 
     def three_d_area(self) -> str:
         return self.page.evaluate("() => window.trame.state.get('vc_three_d_area')")

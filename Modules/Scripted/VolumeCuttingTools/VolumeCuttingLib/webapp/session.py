@@ -204,7 +204,9 @@ class DrillSession:
                 segmentation = None
                 description = "Example head CT (InVesalius)"
             elif source == "phantom":
-                generated = phantom.generate_phantom(dimensions=PHANTOM_DIMENSIONS, spacing=PHANTOM_SPACING, seed=seed)
+                # As a scanner writes it: int16 HU.
+                generated = phantom.generate_phantom(dimensions=PHANTOM_DIMENSIONS, spacing=PHANTOM_SPACING, seed=seed,
+                                                     ct_dtype="int16")
                 volume, segmentation = phantom.create_phantom_nodes(self.scene, generated)
                 description = "Temporal-bone phantom"
             else:
@@ -294,6 +296,8 @@ class DrillSession:
             segmentation.CreateDefaultDisplayNodes()
             display = segmentation.GetDisplayNode()
         display.SetVisibility3D(False)
+        # Slice views: outlines over the CT (trame-slicer's slice views draw the CT black under a fill).
+        display.SetVisibility2DFill(False)
         segments = segmentation.GetSegmentation()
         if shown is None:
             shown = set(cut_node.GetCuttableSegmentIDs()) | set(cut_node.GetProtectedSegmentIDs())

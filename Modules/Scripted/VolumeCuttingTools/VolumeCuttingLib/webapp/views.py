@@ -242,6 +242,9 @@ class DrillController:
         self.on_depth_changed = lambda depth: None
         # Where the surface under the mouse is read: the views' SurfaceDepth (the freshest is used).
         self.depth_sources = lambda: []
+        # Whether the tool is over the surface (its glyph shows in every view) and touches a structure it may not cut.
+        self.placed = False
+        self.in_contact = False
         self.pipelines = []
 
     def set_mode(self, mode: str) -> None:
@@ -258,6 +261,17 @@ class DrillController:
         self.depth_mm = min(max(depth, DEPTH_RANGE_MM[0]), DEPTH_RANGE_MM[1])
         self.on_depth_changed(self.depth_mm)
         return self.depth_mm
+
+    def set_glyph(self, placed: bool | None = None, in_contact: bool | None = None) -> None:
+        """Show or hide the tool's glyph, in contact colour or not, in every view."""
+        changed = False
+        if placed is not None and placed != self.placed:
+            self.placed, changed = placed, True
+        if in_contact is not None and in_contact != self.in_contact:
+            self.in_contact, changed = in_contact, True
+        if changed:
+            for pipeline in self.pipelines:
+                pipeline.UpdateFromMRML()
 
     def end_stroke(self) -> bool:
         """End any open stroke (pointer released, lost, the page gone): what was cut stays."""
@@ -297,13 +311,13 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         self._stroke_depth = None
         self._last_center = None
         self._lifted = False
-        self._in_contact = False
         self._events = {
             int(vtk.vtkCommand.MouseMoveEvent): self._on_move,
             int(vtk.vtkCommand.LeftButtonPressEvent): self._on_press,
             int(vtk.vtkCommand.LeftButtonReleaseEvent): self._on_release,
             int(vtk.vtkCommand.MouseWheelForwardEvent): lambda data: self._on_wheel(+1),
             int(vtk.vtkCommand.MouseWheelBackwardEvent): lambda data: self._on_wheel(-1),
+            int(vtk.vtkCommand.LeaveEvent): self._on_leave,
         }
 
     # -- render layer and MRML
@@ -346,19 +360,11 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
             transform.GetMatrixTransformToWorld(pose)
         self.actor.SetUserMatrix(pose)
         cutting = self.controller.session.in_stroke
-        color = CONTACT_COLOR if self._in_contact else display.GetColor()
+        color = CONTACT_COLOR if self.controller.in_contact else display.GetColor()
         self.actor.GetProperty().SetColor(*color)
         self.actor.GetProperty().SetOpacity(display.GetGlyphOpacityWhileCutting() if cutting else display.GetOpacity())
-        self.actor.SetVisibility(bool(display.GetVisibility()) and transform is not None and self._placed())
+        self.actor.SetVisibility(bool(display.GetVisibility()) and transform is not None and self.controller.placed)
         self.RequestRender()
-
-    def _placed(self) -> bool:
-        return self._last_center is not None
-
-    def set_contact(self, in_contact: bool) -> None:
-        if in_contact != self._in_contact:
-            self._in_contact = in_contact
-            self.UpdateFromMRML()
 
     # -- interaction
 
@@ -428,20 +434,22 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         self.controller.on_stroke_begin()
         session.move_tool(pose)
         self._last_center = center
-        self.UpdateFromMRML()
+        self.controller.set_glyph(placed=True)
+        for pipeline in self.controller.pipelines:
+            pipeline.UpdateFromMRML()  # the glyph turns translucent while it cuts
         self.controller.on_stroke_moved()
         return True
 
     def _on_move(self, event_data) -> bool:
         session = self.controller.session
         if not session.in_stroke:
-            # Hovering: the tool rests on the surface under the pointer.
+            # Hovering: the tool rests on the surface under the pointer, and is hidden off the surface.
             pose, center = self._pose_at(event_data, 0.0)
+            self.controller.on_hover()
             if pose is not None:
-                self.controller.on_hover()
                 session.move_tool(pose)
-                self._last_center = center
-                self.UpdateFromMRML()
+            self._last_center = center
+            self.controller.set_glyph(placed=center is not None)
             return True
         pose, center = self._pose_at(event_data, self._stroke_depth_mm(event_data))
         if pose is None:
@@ -459,6 +467,13 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         self.controller.on_stroke_moved()
         return True
 
+    def _on_leave(self, event_data) -> bool:
+        """The pointer left the view: the stroke ends (what was cut stays) and the glyph hides."""
+        self.controller.end_stroke()
+        self._last_center = None
+        self.controller.set_glyph(placed=False)
+        return False
+
     def _on_release(self, event_data) -> bool:
         self.controller.end_stroke()
         return True
@@ -475,6 +490,7 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
             self.controller.session.end_stroke()
             was_open = True
         if was_open:
-            self.UpdateFromMRML()
+            for pipeline in self.controller.pipelines:
+                pipeline.UpdateFromMRML()  # opaque again
             self.controller.on_stroke_end()
         return was_open
