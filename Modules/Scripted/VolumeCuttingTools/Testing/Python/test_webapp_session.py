@@ -239,3 +239,22 @@ def test_surface_depth_finds_the_surface_under_a_pixel():
     np.testing.assert_allclose(frozen.surface_point(0.5, 0.5)[0], (0.0, 0.0, 5.0), atol=0.05)
     assert depth.surface_point(1.5, 0.5) is None
     window.Finalize()
+
+
+@pytest.mark.parametrize("shape, sizes", [("Sphere", {"diameter": 5.0}), ("Cylinder", {"diameter": 3.0, "length": 8.0}),
+                                           ("DiskSaw", {"diameter": 20.0, "thickness": 1.0}),
+                                           ("Blade", {"width": 10.0, "length": 30.0, "thickness": 0.6})])
+def test_the_glyph_has_the_tool_shape_and_size(session, shape, sizes):
+    from VolumeCuttingLib.webapp.session import half_length_along_shaft
+
+    params = session.set_tool(shape=shape, **sizes)
+    display = session.tool_node.GetVolumeCutToolDisplayNode()
+    display.SetShowAxis(False)
+    bounds = views.tool_glyph(session.tool_node).GetBounds()
+    across = params.width if shape == "Blade" else params.diameter
+    assert bounds[1] - bounds[0] == pytest.approx(across, rel=0.02)
+    assert bounds[4] == pytest.approx(-half_length_along_shaft(session.tool_node), rel=0.02)
+    assert bounds[5] == pytest.approx(half_length_along_shaft(session.tool_node), rel=0.02)
+    display.SetShowAxis(True)
+    assert views.tool_glyph(session.tool_node).GetBounds()[5] == pytest.approx(bounds[5] + 25.0, rel=0.02)
+    session.set_tool(shape="Sphere", diameter=4.0)

@@ -146,7 +146,7 @@ class DrillSession:
             work_directory = self._temporary.name
         self.work_directory = Path(work_directory)
         self.work_directory.mkdir(parents=True, exist_ok=True)
-        self._cache_temporary = configure_scene_io(scene, self.work_directory / "cache")
+        configure_scene_io(scene, self.work_directory / "cache")
         self.volume = None
         self.segmentation = None
         self.bone_segmentation = None

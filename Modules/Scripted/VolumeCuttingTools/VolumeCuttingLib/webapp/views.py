@@ -104,15 +104,23 @@ class SurfaceDepth:
         return point, direction / norm
 
 
+def add_product_displayable_manager(view, manager):
+    """Add the product's displayable manager to a trame-slicer view's group, multisampling off.
+
+    Desktop Slicer creates it by name through its object factory; here it joins the group directly.
+    """
+    view.render_window().SetMultiSamples(0)
+    view._displayable_manager_group.AddDisplayableManager(manager)
+    return manager
+
+
 class VolumeCutThreeDView(ThreeDView):
     """trame-slicer's 3D view with the product's volume-cut displayable manager."""
 
     def __init__(self, scene, app_logic, name, *args, **kwargs):
         super().__init__(scene, app_logic, name, *args, **kwargs)
-        self.render_window().SetMultiSamples(0)
-        # Desktop Slicer creates it by name through its object factory; here it joins the group directly.
-        self.volume_cut_displayable_manager = slicer.vtkMRMLVolumeCutDisplayableManager()
-        self._displayable_manager_group.AddDisplayableManager(self.volume_cut_displayable_manager)
+        self.volume_cut_displayable_manager = add_product_displayable_manager(
+            self, slicer.vtkMRMLVolumeCutDisplayableManager())
         self.surface_depth = SurfaceDepth(self.renderer())
         view_node = self.get_view_node()
         if view_node is not None:
@@ -140,69 +148,64 @@ class VolumeCutSliceView(SliceView):
 
     def __init__(self, scene, app_logic, name, *args, **kwargs):
         super().__init__(scene, app_logic, name, *args, **kwargs)
-        self.render_window().SetMultiSamples(0)
-        self.volume_cut_displayable_manager = slicer.vtkMRMLVolumeCutSliceDisplayableManager()
-        self._displayable_manager_group.AddDisplayableManager(self.volume_cut_displayable_manager)
+        self.volume_cut_displayable_manager = add_product_displayable_manager(
+            self, slicer.vtkMRMLVolumeCutSliceDisplayableManager())
 
 
 # --------------------------------------------------------------------------- the drill
 
 
+def _updated(algorithm) -> vtk.vtkPolyData:
+    algorithm.Update()
+    return algorithm.GetOutput()
+
+
+def _cylinder_along_z(radius: float, height: float, center_z: float, resolution: int) -> vtk.vtkPolyData:
+    """A cylinder whose axis is the z axis (vtkCylinderSource's is y)."""
+    source = vtk.vtkCylinderSource()
+    source.SetRadius(radius)
+    source.SetHeight(height)
+    source.SetCenter(0.0, center_z, 0.0)
+    source.SetResolution(resolution)
+    rotate = vtk.vtkTransform()
+    rotate.RotateX(90.0)  # y to z
+    cylinder = vtk.vtkTransformPolyDataFilter()
+    cylinder.SetTransform(rotate)
+    cylinder.SetInputConnection(source.GetOutputPort())
+    return _updated(cylinder)
+
+
 def tool_glyph(tool_node) -> vtk.vtkPolyData:
     """The tool's cutting part in its local frame (centred, shaft along +z) and its shaft."""
     shape = slicer.vtkMRMLVolumeCutToolNode.GetShapeAsString(tool_node.GetShape())
-    append = vtk.vtkAppendPolyData()
-    top = 0.0
     if shape == "Sphere":
         source = vtk.vtkSphereSource()
         source.SetRadius(tool_node.GetDiameter() / 2.0)
         source.SetThetaResolution(32)
         source.SetPhiResolution(24)
-        top = tool_node.GetDiameter() / 2.0
-        part = source
+        part, top = _updated(source), tool_node.GetDiameter() / 2.0
     elif shape in ("Cylinder", "DiskSaw"):
         height = tool_node.GetLength() if shape == "Cylinder" else tool_node.GetThickness()
-        source = vtk.vtkCylinderSource()
-        source.SetRadius(tool_node.GetDiameter() / 2.0)
-        source.SetHeight(height)
-        source.SetResolution(32)
-        # vtkCylinderSource's axis is y; the tool's is z.
-        rotate = vtk.vtkTransform()
-        rotate.RotateX(90.0)
-        part = vtk.vtkTransformPolyDataFilter()
-        part.SetTransform(rotate)
-        part.SetInputConnection(source.GetOutputPort())
-        top = height / 2.0
+        part, top = _cylinder_along_z(tool_node.GetDiameter() / 2.0, height, 0.0, 32), height / 2.0
     elif shape == "Blade":
-        part = vtk.vtkCubeSource()
-        part.SetXLength(tool_node.GetWidth())
-        part.SetYLength(tool_node.GetThickness())
-        part.SetZLength(tool_node.GetLength())
-        top = tool_node.GetLength() / 2.0
+        source = vtk.vtkCubeSource()
+        source.SetXLength(tool_node.GetWidth())
+        source.SetYLength(tool_node.GetThickness())
+        source.SetZLength(tool_node.GetLength())
+        part, top = _updated(source), tool_node.GetLength() / 2.0
     else:
         mesh = tool_node.GetMeshModelNode()
-        part = vtk.vtkTrivialProducer()
-        part.SetOutput(mesh.GetPolyData() if mesh is not None and mesh.GetPolyData() is not None else vtk.vtkPolyData())
+        part = mesh.GetPolyData() if mesh is not None and mesh.GetPolyData() is not None else vtk.vtkPolyData()
         top = 0.0
-    append.AddInputConnection(part.GetOutputPort())
+    append = vtk.vtkAppendPolyData()
+    append.AddInputData(part)
     display = tool_node.GetVolumeCutToolDisplayNode()
     if display is None or display.GetShowAxis():
         # The shaft towards the handpiece: thin, 25 mm.
-        shaft = vtk.vtkCylinderSource()
-        shaft.SetRadius(0.35)
-        shaft.SetHeight(25.0)
-        shaft.SetCenter(0.0, top + 12.5, 0.0)
-        shaft.SetResolution(12)
-        rotate = vtk.vtkTransform()
-        rotate.RotateX(90.0)
-        shaft_z = vtk.vtkTransformPolyDataFilter()
-        shaft_z.SetTransform(rotate)
-        shaft_z.SetInputConnection(shaft.GetOutputPort())
-        append.AddInputConnection(shaft_z.GetOutputPort())
+        append.AddInputData(_cylinder_along_z(0.35, 25.0, top + 12.5, 12))
     normals = vtk.vtkPolyDataNormals()
     normals.SetInputConnection(append.GetOutputPort())
-    normals.Update()
-    return normals.GetOutput()
+    return _updated(normals)
 
 
 # Drill modes of the 3D view.
