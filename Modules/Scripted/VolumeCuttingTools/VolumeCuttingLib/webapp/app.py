@@ -17,7 +17,6 @@ is told so and may take over, nothing is lost.
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import os
 import time
@@ -281,7 +280,8 @@ class VolumeCuttingApp(TrameApp):
         for event in ("LeftButtonPressEvent", "MiddleButtonPressEvent", "RightButtonPressEvent"):
             interactor.AddObserver(event, lambda *_: self.progressive.button_pressed(), 10.0)
         for event in ("LeftButtonReleaseEvent", "MiddleButtonReleaseEvent", "RightButtonReleaseEvent"):
-            interactor.AddObserver(event, lambda *_: self.progressive.button_released(), -10.0)
+            # Before the interactor style, which may take the event for itself.
+            interactor.AddObserver(event, lambda *_: self.progressive.button_released(), 10.0)
         for name, window in (("main", area.main_view.render_window()), ("preview", area.preview_view.render_window())):
             window.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: self._render_started())
             window.AddObserver(vtk.vtkCommand.EndEvent, lambda w, _e, name=name: self._render_ended(name, w))
@@ -399,6 +399,9 @@ class VolumeCuttingApp(TrameApp):
 
     def _on_stroke_begin(self) -> None:
         self.progressive.stroke_started()
+        # The slice views follow the tool when the stroke ends; meanwhile the 3D view has the processor.
+        for view in self.slicer_app.view_manager.get_slice_views():
+            view.set_render_blocked(True)
         self.state.vc_contact = ""
         self.drill.set_glyph(in_contact=False)
 
@@ -412,6 +415,8 @@ class VolumeCuttingApp(TrameApp):
         self.progressive.stroke_ended()
         self._refresh_tables()
         self._jump_slices_to_tool()
+        for view in self.slicer_app.view_manager.get_slice_views():
+            view.set_render_blocked(False)
 
     def _jump_slices_to_tool(self) -> None:
         """The slice views go through the tool's centre, where the cut was just made."""

@@ -335,13 +335,16 @@ class AppPage:
         return self.page.evaluate("() => window.trame.state.get('vc_three_d_area')")
 
     def fit_three_d_view(self, width: int, height: int, attempts: int = 4) -> dict:
-        """Resize the browser window until the 3D view is ``width`` x ``height`` CSS pixels (device scale 1)."""
+        """Resize the browser window until the 3D view is ``width`` x ``height`` CSS pixels (device scale 1).
+
+        The 3D view takes 3/4 of the width beside the panels and its full height below the toolbar.
+        """
         box = self.three_d_box()
         for _ in range(attempts):
             if round(box["width"]) == width and round(box["height"]) == height:
-                return box
+                break
             viewport = self.page.viewport_size
-            self.page.set_viewport_size({"width": viewport["width"] + round((width - box["width"]) / 0.75) if abs(width - box["width"]) > 0.5 else viewport["width"],
+            self.page.set_viewport_size({"width": viewport["width"] + round((width - box["width"]) * 4 / 3),
                                          "height": viewport["height"] + round(height - box["height"])})
             self.page.wait_for_timeout(500)
             box = self.three_d_box()
