@@ -22,6 +22,7 @@ holds the committed ones), else into pytest's temporary folder.
 """
 
 import os
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -289,3 +290,75 @@ def test_a_page_lost_in_the_middle_of_a_stroke_keeps_the_cut(app, browser, serve
     again.testid("undo").click()
     again.wait_for_total_removed(f"Math.abs(v - {total}) < 0.01", 60)
     context.close()
+
+
+def test_the_launcher_gives_each_user_a_scene_of_their_own(browser, tmp_path):
+    """Two browsers through wslink's launcher: two application processes (on the head CT), nothing shared."""
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    from VolumeCuttingLib.webapp.browser import free_port
+
+    port = free_port()
+    library = str(Path(__import__("VolumeCuttingLib").__file__).resolve().parents[1])
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in (library, os.environ.get("PYTHONPATH", "")) if p),
+               VTK_DEFAULT_OPENGL_WINDOW="vtkEGLRenderWindow")
+    log = open(tmp_path / "launcher.log", "w")
+    # The session ports follow the page's: the test takes a free port and hopes the next three are free too.
+    launcher = subprocess.Popen([sys.executable, "-m", "VolumeCuttingLib.webapp.launcher", "--port", str(port),
+                                 "--sessions", "2", "--folder", str(tmp_path / "launcher")],
+                                stdout=log, stderr=subprocess.STDOUT, env=env)
+    users = []
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                socket.create_connection(("127.0.0.1", port), timeout=0.5).close()
+                break
+            except OSError:
+                assert launcher.poll() is None and time.monotonic() < deadline, (tmp_path / "launcher.log").read_text()
+                time.sleep(0.2)
+        for _ in range(2):
+            context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1)
+            user = AppPage(context.new_page())
+            user.open(f"http://127.0.0.1:{port}/")
+            users.append(user)
+        for user in users:
+            user.wait_ready(300)
+        sessions = [user.page.evaluate("() => window.trame.client.getConfig().sessionURL") for user in users]
+        assert len(set(sessions)) == 2 and all(str(port) not in url for url in sessions)
+        for user in users:
+            assert user.testid("take-over").is_hidden()  # each owns its session
+        users[0].set_mode("drill")
+        users[0].drag([view_point(users[0], 0.40 + 0.004 * i, 0.45) for i in range(30)], 20)
+        users[0].wait_for_total_removed("v > 1", 120)
+        assert users[1].total_removed() == 0.0
+        assert users[1].page.evaluate("() => window.trame.state.get('vc_mode')") == "navigate"
+    finally:
+        for user in users:
+            user.page.context.close()
+        sessions_started = children_of(launcher.pid)
+        launcher.terminate()
+        launcher.wait(timeout=30)
+        # The sessions would end at their own timeout once their page is gone; end them now.
+        for pid in sessions_started:
+            try:
+                os.kill(pid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
+        log.close()
+
+
+def children_of(pid: int) -> list[int]:
+    """Process IDs whose parent is ``pid`` (from /proc)."""
+    children = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            children.append(int(stat.parent.name))
+    return children
