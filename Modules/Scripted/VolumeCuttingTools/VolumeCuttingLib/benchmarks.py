@@ -494,11 +494,18 @@ def sliceview(repeats: int) -> list[dict]:
     return slicebenchmarks.sliceview(repeats)
 
 
+def webapp(repeats: int) -> list[dict]:
+    from .webapp import benchmark
+
+    return benchmark.webapp(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
     "sliceview": sliceview,
+    "webapp": webapp,
 }
 
 
