@@ -13,9 +13,11 @@ module; the tests run in file order on its page, each wait time-limited:
 5. undo gives back the previous image and volumes;
 6. each export downloads a file that Slicer Core reads back (closed STL,
    segment, drilled CT, a bundle with the same cut);
-7. bad input: a file that is not an image, a file over the limit, a server
+7. Restore mode adds bone back into the groove, and undo takes it away;
+8. bad input: a file that is not an image, a file over the limit, a server
    path outside the allowed folder, the page lost in the middle of a
-   stroke, and a second tab on the session: a clear message, nothing lost.
+   stroke, and a second tab on the session: a clear message, nothing lost;
+9. several users through wslink's launcher (a process and a scene each).
 
 Screenshots of the steps go to ``$VOLUMECUTTING_SCREENSHOTS`` (Docs/webapp
 holds the committed ones), else into pytest's temporary folder.
@@ -203,6 +205,19 @@ def test_each_export_downloads_a_file_slicer_reads(app, tmp_path, shots):
     check_exports(paths, app.total_removed(), tmp_path, tolerance_mm3=0.006)  # the page rounds to 0.01 mm3
 
 
+def test_restore_mode_adds_bone_back_into_the_groove(app):
+    total = app.total_removed()
+    app.set_mode("restore")
+    # Along the groove of the drilling test: the tool rests in it and fills it.
+    app.drag([view_point(app, 0.40 + 0.004 * i, 0.45 + 0.001 * i) for i in range(40)], 20)
+    restored = app.wait_for_total_removed(f"v < {total - 1.0}", 60)
+    assert app.removed_volume(PROTECTED) == 0.0
+    app.testid("undo").click()
+    app.wait_for_total_removed(f"Math.abs(v - {total}) < 0.01", 60)
+    app.set_mode("drill")
+    assert 0.0 <= restored < total
+
+
 def test_an_upload_that_is_not_an_image_is_refused_and_nothing_is_lost(app, tmp_path, shots):
     total = app.total_removed()
     app.page.locator('[data-testid="source"]').click()
@@ -249,6 +264,10 @@ def test_a_second_tab_is_told_and_can_take_over(app, browser, server, shots):
     second.testid("take-over").wait_for(state="visible", timeout=60000)
     assert "open in another tab" in second.testid("tab-overlay").inner_text()
     assert app.testid("take-over").is_hidden()
+    # The views here follow the session: the 3D view and the three slice views get their images.
+    second.wait_for("() => [...document.querySelectorAll('img')].filter(i => i.complete && i.naturalWidth > 100).length >= 4",
+                    60, "the second tab's views to show the session")
+    second.page.wait_for_timeout(500)
     second.screenshot(shots / "08-second-tab.png")
     second.testid("take-over").click()
     app.testid("take-over").wait_for(state="visible", timeout=30000)
@@ -293,7 +312,7 @@ def test_a_page_lost_in_the_middle_of_a_stroke_keeps_the_cut(app, browser, serve
 
 
 def test_the_launcher_gives_each_user_a_scene_of_their_own(browser, tmp_path):
-    """Two browsers through wslink's launcher: two application processes (on the head CT), nothing shared."""
+    """Two browsers through wslink's launcher: two application processes (on the phantom), nothing shared."""
     import socket
     import subprocess
     import sys
@@ -308,7 +327,7 @@ def test_the_launcher_gives_each_user_a_scene_of_their_own(browser, tmp_path):
     log = open(tmp_path / "launcher.log", "w")
     # The session ports follow the page's: the test takes a free port and hopes the next three are free too.
     launcher = subprocess.Popen([sys.executable, "-m", "VolumeCuttingLib.webapp.launcher", "--port", str(port),
-                                 "--sessions", "2", "--folder", str(tmp_path / "launcher")],
+                                 "--sessions", "2", "--folder", str(tmp_path / "launcher"), "--", "--phantom"],
                                 stdout=log, stderr=subprocess.STDOUT, env=env)
     users = []
     try:
