@@ -802,7 +802,9 @@ class VolumeCuttingApp(TrameApp):
                      "hold Shift to drill twice as deep. Restore mode adds bone back.", classes="text-caption")
             html.Div("Undo steps: {{ vc_undo_count }}, redo steps: {{ vc_redo_count }}", classes="text-caption mt-1")
             with html.Div(v_if="vc_contacts.length", classes="mt-2", raw_attrs=['data-testid="contacts"']):
-                html.Div("Contacts with structures the tool may not cut:", classes="text-body-2 text-error")
+                # The logic's contact table is a record of the session: undo takes the cut back, not the contact.
+                html.Div("Touched so far (structures the tool may not cut; undo keeps this record):",
+                         classes="text-body-2 text-error")
                 with html.Div(v_for="(c, i) in vc_contacts", key="i", classes="text-caption"):
                     html.Span("{{ c.name }}: {{ c.depth.toFixed(2) }} mm")
 
