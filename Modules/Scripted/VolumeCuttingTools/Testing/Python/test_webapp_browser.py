@@ -17,6 +17,8 @@ module; the tests run in file order on its page, each wait time-limited:
 8. bad input: a file that is not an image, a file over the limit, a server
    path outside the allowed folder, the page lost in the middle of a
    stroke, and a second tab on the session: a clear message, nothing lost;
+   then a scan of the user's own by its server path, without segmentation:
+   the bone is segmented automatically (with progress) and drilled;
 9. several users through wslink's launcher (a process and a scene each).
 
 Screenshots of the steps go to ``$VOLUMECUTTING_SCREENSHOTS`` (Docs/webapp
@@ -203,6 +205,7 @@ def test_each_export_downloads_a_file_slicer_reads(app, tmp_path, shots):
     assert paths["stl"].name.endswith("removed.stl") and paths["scene"].suffix == ".mrb"
     app.screenshot(shots / "06-exports.png")
     check_exports(paths, app.total_removed(), tmp_path, tolerance_mm3=0.006)  # the page rounds to 0.01 mm3
+    shared["drilled_ct"] = paths["drilled_ct"]
 
 
 def test_restore_mode_adds_bone_back_into_the_groove(app):
@@ -308,6 +311,40 @@ def test_a_page_lost_in_the_middle_of_a_stroke_keeps_the_cut(app, browser, serve
     # The stroke was closed: undo takes exactly it back.
     again.testid("undo").click()
     again.wait_for_total_removed(f"Math.abs(v - {total}) < 0.01", 60)
+    context.close()
+
+
+def test_an_own_scan_by_its_server_path_is_segmented_automatically_and_drilled(browser, server, data_dir, shots):
+    """The drilled CT just exported, as a scan of the user's own in the allowed folder, without a segmentation."""
+    scan = data_dir / "my-temporal-bone.nrrd"
+    scan.write_bytes(shared["drilled_ct"].read_bytes())
+    context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1)
+    page = AppPage(context.new_page(), timing=True)
+    page.open(server.url)
+    page.wait_ready(120)
+    page.page.evaluate("() => window.trame.state.set('vc_uploaded', {ct: '', segmentation: ''})")
+    page.page.locator('[data-testid="source"]').click()
+    page.page.locator(".v-overlay--active .v-list-item", has_text="My own scan").click()
+    page.testid("ct-path").locator("input").fill(str(scan))
+    # The progress the page shows while loading: every step's fraction, as the state carried it.
+    page.page.evaluate("""() => { window.__vcProgress = [];
+        const watch = () => { window.__vcProgress.push([window.trame.state.get('vc_busy'), window.trame.state.get('vc_progress'),
+                                                         window.trame.state.get('vc_status')]);
+                              if (window.__vcProgress.length < 3000) setTimeout(watch, 10); };
+        watch(); }""")
+    page.testid("load").click()
+    page.wait_for("() => (document.querySelector('[data-testid=status]')?.textContent || '').includes('Ready: my-temporal-bone.nrrd')",
+                  120, "the own scan to be ready")
+    progress = page.page.evaluate("() => window.__vcProgress")
+    assert any(busy and "Segmenting bone automatically" in (status or "") for busy, _, status in progress)
+    assert page.page.locator("[data-removed-of]").count() == 2  # cortical and trabecular bone
+    assert page.total_removed() == 0.0
+    assert page.testid("upload-message").is_hidden()  # the earlier refused upload's message went with the old data
+    page.wait_still(1500, 180)
+    page.screenshot(shots / "09-own-scan-segmented.png")
+    page.set_mode("drill")
+    page.drag([view_point(page, 0.40 + 0.004 * i, 0.50) for i in range(30)], 20)
+    page.wait_for_total_removed("v > 1", 60)
     context.close()
 
 

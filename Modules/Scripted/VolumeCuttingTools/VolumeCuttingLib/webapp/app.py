@@ -596,6 +596,7 @@ class VolumeCuttingApp(TrameApp):
                 await asyncio.sleep(0.05)
             self._refresh_after_data()
             state.vc_status = "Ready: " + self.session.description
+            state.vc_upload_message = ""  # a refused upload's message no longer applies to the data shown
         except (SessionError, owndata.InputError, headct.HeadCTUnavailableError, OSError) as error:
             state.vc_error = self._with_upload_names(str(error))
             state.vc_status = "Not loaded; the previous data stays" if self.session.has_data else "Not loaded"
