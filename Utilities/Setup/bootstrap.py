@@ -3,9 +3,11 @@
 Run by both README commands (through Utilities/vc). Each step checks first and only
 does what is missing:
 
-1. Debian bookworm packages (compiler, CMake, Ninja, hidapi, libusb, umockdev, Mesa EGL);
+1. Debian bookworm packages (compiler, CMake, Ninja, hidapi, libusb, umockdev, Mesa EGL,
+   and Chromium, the browser the web application's tests drive);
 2. the project virtual environment ``.venv`` with the exact wheels of
-   ``requirements.lock`` (hash-checked), downloaded once into the cache;
+   ``requirements.lock`` and, without their declared dependencies, of
+   ``requirements-nodeps.lock`` (hash-checked), downloaded once into the cache;
 3. the VTK 9.6.2 SDK matching the vtk wheel, assembled from Debian sid (vtk_sdk.py);
 4. the slicer-core-sdk adjustments (slicer_sdk.py);
 5. the real head CT (Debian's invesalius-examples), cached;
@@ -42,6 +44,8 @@ APT_PACKAGES = [
     "umockdev", "libumockdev-dev",
     # Offscreen rendering without a display: VTK falls back to EGL on Mesa.
     "libegl1", "libegl-mesa0", "libgl1-mesa-dri",
+    # The browser that Playwright drives in the web application's tests (no browser download).
+    "chromium",
 ]
 
 
@@ -102,9 +106,16 @@ def site_packages() -> Path:
     return REPO / ".venv" / "lib" / f"python{PYTHON_VERSION[0]}.{PYTHON_VERSION[1]}" / "site-packages"
 
 
+def _pip(arguments: list[str], what: str) -> None:
+    result = subprocess.run([str(venv_python()), "-m", "pip", "--disable-pip-version-check", *arguments],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        raise SetupError(f"{what}:\n{result.stderr.strip()[-2000:]}")
+
+
 def ensure_venv(cache: Path) -> None:
-    lock = HERE / "requirements.lock"
-    lock_hash = hashlib.sha256(lock.read_bytes()).hexdigest()
+    locks = [HERE / "requirements.lock", HERE / "requirements-nodeps.lock"]
+    lock_hash = hashlib.sha256(b"".join(lock.read_bytes() for lock in locks)).hexdigest()
     stamp = REPO / ".venv" / ".volumecutting-lock"
     if venv_python().exists() and stamp.exists() and stamp.read_text().strip() == lock_hash:
         return
@@ -114,19 +125,14 @@ def ensure_venv(cache: Path) -> None:
     wheels = cache / "wheels"
     wheels.mkdir(exist_ok=True)
     say("fetching the pinned wheels (cached in " f"{wheels})")
-    download = subprocess.run(
-        [str(venv_python()), "-m", "pip", "download", "-q", "--disable-pip-version-check", "--only-binary=:all:",
-         "--require-hashes", "--no-deps", "-d", str(wheels), "-r", str(lock)], capture_output=True, text=True)
-    if download.returncode != 0:
-        raise SetupError("Could not obtain the pinned wheels of Utilities/Setup/requirements.lock "
-                         f"(is PyPI reachable?):\n{download.stderr.strip()[-2000:]}")
+    for lock in locks:
+        _pip(["download", "-q", "--only-binary=:all:", "--require-hashes", "--no-deps", "-d", str(wheels), "-r", str(lock)],
+             f"Could not obtain the pinned wheels of Utilities/Setup/{lock.name} (is PyPI reachable?)")
     say("installing the pinned wheels into .venv")
-    install = subprocess.run(
-        [str(venv_python()), "-m", "pip", "install", "-q", "--disable-pip-version-check", "--no-index",
-         "--find-links", str(wheels), "--require-hashes", "--only-binary=:all:", "-r", str(lock)],
-        capture_output=True, text=True)
-    if install.returncode != 0:
-        raise SetupError(f"Installing the pinned wheels failed:\n{install.stderr.strip()[-2000:]}")
+    offline = ["install", "-q", "--no-index", "--find-links", str(wheels), "--require-hashes", "--only-binary=:all:"]
+    _pip([*offline, "-r", str(locks[0])], "Installing the pinned wheels failed")
+    # Their declared dependencies are not what this product pins (see the file): installed as they are.
+    _pip([*offline, "--no-deps", "-r", str(locks[1])], f"Installing the wheels of {locks[1].name} failed")
     stamp.write_text(lock_hash + "\n")
 
 

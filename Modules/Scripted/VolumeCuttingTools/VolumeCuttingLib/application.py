@@ -63,6 +63,27 @@ def opengl_renderer_name(render_window) -> str:
     return "unknown"
 
 
+def configure_scene_io(scene, cache_directory: str | Path | None = None):
+    """Give a scene the data I/O and cache managers that scene bundles (.mrb) need, as desktop Slicer does.
+
+    Reading a bundle unpacks it into the cache manager's folder: ``cache_directory``,
+    or a temporary folder, whose ``TemporaryDirectory`` is returned (keep it
+    alive as long as the scene; None when a folder was given).
+    """
+    temporary = None
+    if cache_directory is None:
+        temporary = tempfile.TemporaryDirectory(prefix="volumecutting-cache-")
+        cache_directory = temporary.name
+    Path(cache_directory).mkdir(parents=True, exist_ok=True)
+    cache_manager = slicer.vtkCacheManager()
+    cache_manager.SetRemoteCacheDirectory(str(cache_directory))
+    data_io_manager = slicer.vtkDataIOManager()
+    data_io_manager.SetCacheManager(cache_manager)
+    scene.SetCacheManager(cache_manager)
+    scene.SetDataIOManager(data_io_manager)
+    return temporary
+
+
 class HeadlessSlicer:
     """A scene with the application and module logics that VolumeCutting relies on.
 
@@ -73,17 +94,7 @@ class HeadlessSlicer:
 
     def __init__(self, cache_directory: str | Path | None = None):
         self.scene = slicer.vtkMRMLScene()
-        # Reading a scene bundle (.mrb) unpacks it into the cache manager's folder.
-        self._temporary = None
-        if cache_directory is None:
-            self._temporary = tempfile.TemporaryDirectory(prefix="volumecutting-cache-")
-            cache_directory = self._temporary.name
-        cache_manager = slicer.vtkCacheManager()
-        cache_manager.SetRemoteCacheDirectory(str(cache_directory))
-        data_io_manager = slicer.vtkDataIOManager()
-        data_io_manager.SetCacheManager(cache_manager)
-        self.scene.SetCacheManager(cache_manager)
-        self.scene.SetDataIOManager(data_io_manager)
+        self._temporary = configure_scene_io(self.scene, cache_directory)
 
         self.application_logic = slicer.vtkSlicerApplicationLogic()
         self.application_logic.SetMRMLScene(self.scene)

@@ -512,6 +512,12 @@ def softcut(repeats: int) -> list[dict]:
     return softcutbenchmarks.softcut_area(repeats)
 
 
+def webapp(repeats: int) -> list[dict]:
+    from .webapp import benchmark
+
+    return benchmark.webapp(repeats)
+
+
 AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
@@ -520,6 +526,7 @@ AREAS = {
     "haptics": haptics,
     "sliceview": sliceview,
     "softcut": softcut,
+    "webapp": webapp,
 }
 
 

@@ -19,3 +19,7 @@ def pytest_configure(config):
         "realdata: needs the real head CT from Debian's invesalius-examples package "
         "(fetched into the user cache on first use; skipped if it cannot be obtained)",
     )
+    config.addinivalue_line(
+        "markers",
+        "browser: drives the web application in Debian's Chromium through Playwright (deselect with -m 'not browser')",
+    )

@@ -1,0 +1,260 @@
+"""The web application's session without a browser (VolumeCuttingLib.webapp.session, views, app helpers).
+
+A real scene with trame-slicer's SlicerApp and the VolumeCutting logic, the
+temporal-bone phantom, strokes through the logic, exports read back with
+Slicer's storage nodes. The page itself is tested in test_webapp_browser.py.
+"""
+
+import zipfile
+
+import numpy as np
+import pytest
+import slicer
+import vtk
+
+from VolumeCuttingLib import owndata
+from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.webapp import app as webapp
+from VolumeCuttingLib.webapp import views
+from VolumeCuttingLib.webapp.session import DrillSession, SessionError, tool_pose
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    from trame_slicer.core import SlicerApp
+
+    slicer_app = SlicerApp()
+    logic = slicer_app.register_module_logic(slicer.vtkSlicerVolumeCuttingLogic(), logic_name="VolumeCutting")
+    drill_session = DrillSession(slicer_app.scene, logic, tmp_path_factory.mktemp("webapp-session"))
+    steps = list(drill_session.loading("phantom"))
+    assert [text for _, text in steps][0] == "Reading the CT" and steps[-1] == (1.0, "Ready")
+    assert [f for f, _ in steps] == sorted(f for f, _ in steps)
+    yield drill_session
+    drill_session.close()
+
+
+def lateral_point(session, y=0.0, z=0.0):
+    """The first voxel of the mastoid cortex seen from the patient's right at (y, z) (RAS mm)."""
+    from VolumeCuttingLib import drilling
+
+    return drilling.lateral_entry(session.volume, y, z, threshold=1000.0)
+
+
+def stroke(session, points, depth, restore=False):
+    assert session.begin_stroke(restore=restore)
+    for point in points:
+        assert session.move_tool(tool_pose(point, (-1.0, 0.0, 0.0), depth, session.tool_reach()))
+    assert session.end_stroke()
+
+
+def test_tool_pose_puts_the_tip_at_the_depth_with_the_shaft_towards_the_eye():
+    pose = tool_pose((10.0, 2.0, -3.0), (0.0, 0.0, -2.0), 1.5, 2.0)
+    matrix = np.array([[pose.GetElement(r, c) for c in range(4)] for r in range(4)])
+    np.testing.assert_allclose(matrix[:3, :3] @ matrix[:3, :3].T, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.det(matrix[:3, :3]), 1.0)
+    np.testing.assert_allclose(matrix[:3, 2], (0.0, 0.0, 1.0))  # shaft back along the view
+    center = matrix[:3, 3]
+    np.testing.assert_allclose(center, (10.0, 2.0, -3.0 - 1.5 + 2.0))  # tip 1.5 mm below the surface
+    with pytest.raises(ValueError, match="no length"):
+        tool_pose((0, 0, 0), (0, 0, 0), 1.0, 1.0)
+
+
+def test_roles_and_a_stroke_that_touches_a_protected_segment(session):
+    session.set_role("MastoidBone", "protected")
+    rows = {row.segment_id: row for row in session.segment_rows()}
+    assert rows["MastoidBone"].role == "protected" and rows["MastoidCortex"].role == "cuttable"
+    assert rows["MastoidCortex"].color.startswith("#") and len(rows["MastoidCortex"].color) == 7
+    with pytest.raises(SessionError, match="not one of cuttable"):
+        session.set_role("MastoidBone", "sometimes")
+    with pytest.raises(SessionError, match="no segment 'Brain'"):
+        session.set_role("Brain", "protected")
+
+    entry = lateral_point(session)
+    # 1 mm into the cortex: cortex removed, nothing protected touched.
+    stroke(session, [entry + (0.0, 0.5 * i, 0.0) for i in range(8)], 1.0)
+    removed = session.removed_volumes()
+    assert removed["MastoidCortex"] > 1.0 and removed["MastoidBone"] == 0.0
+    assert session.contact() is None
+    # 4 mm in: through the cortex into the protected bone, which stays.
+    stroke(session, [entry + (0.0, -4.0, 0.5 * i) for i in range(6)], 4.0)
+    contact = session.contact()
+    assert contact is not None and contact.segment_id == "MastoidBone" and contact.depth_mm > 0.5
+    assert session.removed_volumes()["MastoidBone"] == 0.0
+    assert session.undo_redo_counts() == (2, 0)
+
+    total = session.total_removed_volume()
+    assert session.undo()
+    assert session.total_removed_volume() < total
+    assert session.redo()
+    assert session.total_removed_volume() == pytest.approx(total, abs=1e-6)
+    session.set_role("MastoidBone", "cuttable")
+
+
+def test_restore_adds_bone_back_inside_the_cut(session):
+    entry = lateral_point(session, y=6.0, z=-6.0)
+    stroke(session, [entry], 2.0)
+    removed = session.total_removed_volume()
+    stroke(session, [entry], 2.0, restore=True)
+    assert session.total_removed_volume() < removed - 1.0
+
+
+def test_tool_parameters_and_presets(session):
+    name = session.preset_names()[0]
+    params = session.apply_preset(name)
+    assert session.tool_parameters() == params
+    assert session.set_tool(diameter=3.0).diameter == 3.0
+    assert session.tool_reach() == pytest.approx(1.5)
+    from VolumeCuttingLib import toolconfig
+
+    with pytest.raises(toolconfig.ToolConfigError, match="diameter"):
+        session.set_tool(diameter=70.0)
+    assert session.tool_parameters().diameter == 3.0  # the node kept its value
+    with pytest.raises(SessionError, match="no tool preset named 'Chainsaw'"):
+        session.apply_preset("Chainsaw")
+    session.set_tool(diameter=4.0)
+
+
+def test_exports_read_back_with_slicer(session, tmp_path):
+    def node_classes():
+        scene = session.scene
+        return {scene.GetNthNode(i).GetID(): scene.GetNthNode(i).GetClassName() for i in range(scene.GetNumberOfNodes())}
+
+    before = node_classes()
+    paths = {kind: session.export(kind) for kind in ("stl", "segmentation", "drilled_ct")}
+    assert node_classes() == before  # exports leave nothing behind
+    paths["scene"] = session.export("scene")
+    # Saving a scene gives its data nodes storage nodes, as desktop Slicer does; nothing else.
+    added = {node_id: name for node_id, name in node_classes().items() if node_id not in before}
+    assert added and all(name.endswith("StorageNode") for name in added.values())
+    check_exports(paths, session.total_removed_volume(), tmp_path)
+
+
+def check_exports(paths, removed_mm3, tmp_path, tolerance_mm3=1e-6):
+    """Read every export back with Slicer Core: a closed STL, a segment, a CT, a bundle with the same cut."""
+    scene = HeadlessSlicer(tmp_path / "readback-cache")
+    model = scene.scene.AddNewNodeByClass("vtkMRMLModelNode")
+    storage = slicer.vtkMRMLModelStorageNode()
+    storage.SetFileName(str(paths["stl"]))
+    assert storage.ReadData(model)
+    edges = vtk.vtkFeatureEdges()
+    edges.SetInputData(model.GetPolyData())
+    edges.BoundaryEdgesOn()
+    edges.NonManifoldEdgesOn()
+    edges.FeatureEdgesOff()
+    edges.ManifoldEdgesOff()
+    edges.Update()
+    assert model.GetPolyData().GetNumberOfCells() > 100
+    assert edges.GetOutput().GetNumberOfCells() == 0  # closed
+
+    segmentation = scene.scene.AddNewNodeByClass("vtkMRMLSegmentationNode")
+    segmentation_storage = slicer.vtkMRMLSegmentationStorageNode()
+    segmentation_storage.SetFileName(str(paths["segmentation"]))
+    assert segmentation_storage.ReadData(segmentation)
+    assert segmentation.GetSegmentation().GetNumberOfSegments() == 1
+
+    volume = scene.scene.AddNewNodeByClass("vtkMRMLScalarVolumeNode")
+    volume_storage = slicer.vtkMRMLVolumeArchetypeStorageNode()
+    volume_storage.SetFileName(str(paths["drilled_ct"]))
+    assert volume_storage.ReadData(volume)
+    assert volume.GetImageData().GetScalarRange()[0] <= -999.0  # drilled voxels are air
+
+    bundle = HeadlessSlicer(tmp_path / "bundle-cache")
+    bundle.load_bundle(paths["scene"])
+    cut_nodes = [bundle.scene.GetNthNodeByClass(i, "vtkMRMLVolumeCutNode")
+                 for i in range(bundle.scene.GetNumberOfNodesByClass("vtkMRMLVolumeCutNode"))]
+    assert len(cut_nodes) == 1
+    assert bundle.volume_cutting_logic.GetRemovedVolume(cut_nodes[0]) == pytest.approx(removed_mm3, abs=tolerance_mm3)
+
+
+def test_a_load_that_fails_keeps_the_previous_data(session, tmp_path):
+    cut_node, nodes_before = session.cut_node, session.scene.GetNumberOfNodes()
+    removed = session.total_removed_volume()
+    not_an_image = tmp_path / "scan.nrrd"
+    not_an_image.write_text("these are notes, not a CT\n")
+    with pytest.raises(owndata.InputError, match="scan.nrrd"):
+        session.load("own", ct_path=not_an_image)
+    assert session.cut_node is cut_node and session.scene.GetNumberOfNodes() == nodes_before
+    assert session.total_removed_volume() == removed
+    with pytest.raises(SessionError, match="Give the CT"):
+        session.load("own")
+
+
+def test_only_allowed_folders_are_read(tmp_path):
+    allowed = tmp_path / "scans"
+    allowed.mkdir()
+    (allowed / "ct.nrrd").write_bytes(b"")
+    assert webapp.path_allowed(allowed / "ct.nrrd", [allowed.resolve()])
+    assert webapp.path_allowed(allowed / "series" / "missing.dcm", [allowed.resolve()])
+    assert not webapp.path_allowed(allowed / ".." / "other.nrrd", [allowed.resolve()])
+    assert not webapp.path_allowed("/etc/passwd", [allowed.resolve()])
+    (allowed / "passwd").symlink_to("/etc/passwd")
+    assert not webapp.path_allowed(allowed / "passwd", [allowed.resolve()])
+
+
+def test_a_zip_that_reaches_outside_its_folder_is_refused(tmp_path):
+    archive = tmp_path / "series.zip"
+    with zipfile.ZipFile(archive, "w") as bundle:
+        bundle.writestr("../../outside.txt", "x")
+    with pytest.raises(SessionError, match="outside its folder"):
+        webapp.unpack_upload([archive], tmp_path, 2**20)
+    assert not (tmp_path.parent / "outside.txt").exists()
+    huge = tmp_path / "huge.zip"
+    with zipfile.ZipFile(huge, "w", compression=zipfile.ZIP_DEFLATED) as bundle:
+        bundle.writestr("ct.nrrd", b"\0" * (3 * 2**20))
+    with pytest.raises(SessionError, match="unpacked it holds 3.0 MB"):
+        webapp.unpack_upload([huge], tmp_path / "huge", 2**20)
+
+
+def test_surface_depth_finds_the_surface_under_a_pixel():
+    renderer = vtk.vtkRenderer()
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(True)
+    window.SetMultiSamples(0)
+    window.SetSize(200, 160)
+    window.AddRenderer(renderer)
+    plane = vtk.vtkPlaneSource()
+    plane.SetOrigin(-50, -50, 5.0)
+    plane.SetPoint1(50, -50, 5.0)
+    plane.SetPoint2(-50, 50, 5.0)
+    mapper = vtk.vtkPolyDataMapper()
+    mapper.SetInputConnection(plane.GetOutputPort())
+    actor = vtk.vtkActor()
+    actor.SetMapper(mapper)
+    renderer.AddActor(actor)
+    camera = renderer.GetActiveCamera()
+    camera.SetPosition(0, 0, 100)
+    camera.SetFocalPoint(0, 0, 0)
+    renderer.ResetCameraClippingRange()
+    depth = views.SurfaceDepth(renderer)
+    window.Render()
+    point, direction = depth.surface_point(0.5, 0.5)
+    np.testing.assert_allclose(point, (0.0, 0.0, 5.0), atol=0.05)
+    np.testing.assert_allclose(direction, (0.0, 0.0, -1.0), atol=1e-6)
+    point, _ = depth.surface_point(0.75, 0.5)
+    assert point[0] > 5.0 and point[2] == pytest.approx(5.0, abs=0.05)
+    frozen = depth.snapshot()
+    camera.SetPosition(0, 0, 60)
+    renderer.ResetCameraClippingRange()
+    window.Render()
+    np.testing.assert_allclose(frozen.surface_point(0.5, 0.5)[0], (0.0, 0.0, 5.0), atol=0.05)
+    assert depth.surface_point(1.5, 0.5) is None
+    window.Finalize()
+
+
+@pytest.mark.parametrize("shape, sizes", [("Sphere", {"diameter": 5.0}), ("Cylinder", {"diameter": 3.0, "length": 8.0}),
+                                           ("DiskSaw", {"diameter": 20.0, "thickness": 1.0}),
+                                           ("Blade", {"width": 10.0, "length": 30.0, "thickness": 0.6})])
+def test_the_glyph_has_the_tool_shape_and_size(session, shape, sizes):
+    from VolumeCuttingLib.webapp.session import half_length_along_shaft
+
+    params = session.set_tool(shape=shape, **sizes)
+    display = session.tool_node.GetVolumeCutToolDisplayNode()
+    display.SetShowAxis(False)
+    bounds = views.tool_glyph(session.tool_node).GetBounds()
+    across = params.width if shape == "Blade" else params.diameter
+    assert bounds[1] - bounds[0] == pytest.approx(across, rel=0.02)
+    assert bounds[4] == pytest.approx(-half_length_along_shaft(session.tool_node), rel=0.02)
+    assert bounds[5] == pytest.approx(half_length_along_shaft(session.tool_node), rel=0.02)
+    display.SetShowAxis(True)
+    assert views.tool_glyph(session.tool_node).GetBounds()[5] == pytest.approx(bounds[5] + 25.0, rel=0.02)
+    session.set_tool(shape="Sphere", diameter=4.0)

@@ -1,0 +1,7 @@
+"""``python -m VolumeCuttingLib.webapp``: serve the drilling application (``Utilities/vc app``)."""
+
+import sys
+
+from .app import main
+
+sys.exit(main())

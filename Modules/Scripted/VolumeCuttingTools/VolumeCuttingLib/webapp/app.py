@@ -1,0 +1,842 @@
+"""The VolumeCutting web application: segmentation, then drill, in the browser (trame-slicer).
+
+    python -m VolumeCuttingLib.webapp [--port N] [--host H] [--phantom | --ct PATH [--segmentation PATH]]
+                                      [--data-dir DIR ...] [--max-upload-mb N] [--server]
+
+One page: a 3D view drawn by ``vtkMRMLVolumeCutDisplayableManager`` (the cut
+anatomy through the product's ray caster) and three slice views with the cut
+region's outline (``vtkMRMLVolumeCutSliceDisplayableManager``); panels for
+the data, the segments and their roles, the tool, the drill and the exports.
+Rendering happens here (offscreen; Mesa llvmpipe without a GPU) and trame-rca
+streams the images.
+
+One process serves one session (one scene). More users get a process each
+through trame's launcher (see the README); a second tab on the same process
+is told so and may take over, nothing is lost.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import time
+import zipfile
+from collections import deque
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import slicer
+import vtk
+from trame.app import TrameApp
+from trame.ui.vuetify3 import SinglePageWithDrawerLayout
+from trame.widgets import client, html
+from trame.widgets import vuetify3 as v3
+from trame_slicer import module as trame_slicer_module
+from trame_slicer.app.logic import get_view_trame_id
+from trame_slicer.app.ui import create_vertical_slice_view_gutter_ui
+from trame_slicer.core import LayoutManager, SlicerApp
+from trame_slicer.rca_view.rca_view_factory import RemoteViewFactory
+from trame_slicer.views import Layout, LayoutDirection, ViewLayoutDefinition, ViewType
+from trame_server.utils.asynchronous import create_task
+from wslink.websocket import LinkProtocol
+
+from .. import headct, owndata, toolconfig
+from . import rendering, views
+from .session import DrillSession, SessionError
+
+WWW = Path(__file__).with_name("www")
+CLIENT_MODULE = {"serve": {"__volumecutting": str(WWW)}, "scripts": ["__volumecutting/volumecutting.js"]}
+
+LAYOUT_ID = "volumecutting"
+# VOLUMECUTTING_WEBAPP_TRACE=1 prints each frame of the 3D view (window, size, time).
+TRACE = os.environ.get("VOLUMECUTTING_WEBAPP_TRACE") == "1"
+THREE_D_TAG = "ThreeD"
+
+ROLE_ITEMS = [
+    {"title": "cuttable", "value": toolconfig.ROLE_CUTTABLE},
+    {"title": "protected", "value": toolconfig.ROLE_PROTECTED},
+    {"title": "none", "value": toolconfig.ROLE_NONE},
+]
+SOURCE_ITEMS = [
+    {"title": "Example head CT", "value": "headct"},
+    {"title": "Temporal-bone phantom", "value": "phantom"},
+    {"title": "My own scan", "value": "own"},
+]
+EXPORT_FILES = {
+    "stl": ("removed.stl", "model/stl"),
+    "segmentation": ("removed.seg.nrrd", "application/octet-stream"),
+    "drilled_ct": ("drilled.nrrd", "application/octet-stream"),
+    "scene": ("drilled.mrb", "application/zip"),
+}
+
+
+@dataclass
+class Options:
+    """What the command line sets (see ``add_arguments``)."""
+
+    source: str = "headct"
+    ct: Path | None = None
+    segmentation: Path | None = None
+    data_dirs: list[Path] = field(default_factory=list)
+    max_upload_mb: float = 512.0
+    navigate_scale: float = 0.25
+    drill_scale: float = 0.5
+    refine_delay_s: float = 0.5
+    work_dir: Path | None = None
+
+    @property
+    def max_upload_bytes(self) -> int:
+        return int(self.max_upload_mb * 1024 * 1024)
+
+
+def add_arguments(parser) -> None:
+    group = parser.add_argument_group("VolumeCutting")
+    data = group.add_mutually_exclusive_group()
+    data.add_argument("--phantom", action="store_true", help="start with the temporal-bone phantom")
+    data.add_argument("--ct", type=Path, default=None,
+                      help="start with this CT: a DICOM series folder, .nrrd, .nii, .nii.gz, .mha (default: the example head CT)")
+    group.add_argument("--segmentation", type=Path, default=None, help="its segmentation (.seg.nrrd or labelmap), with --ct")
+    group.add_argument("--data-dir", type=Path, action="append", default=[],
+                       help="a folder whose files users may load by path (repeatable; default: the download cache)")
+    group.add_argument("--max-upload-mb", type=float, default=Options.max_upload_mb, help="largest upload accepted (MB)")
+    group.add_argument("--navigate-scale", type=float, default=Options.navigate_scale,
+                       help="render scale of the 3D view while the camera moves (refined when the mouse stops)")
+    group.add_argument("--drill-scale", type=float, default=Options.drill_scale, help="render scale of the 3D view while drilling")
+    group.add_argument("--work-dir", type=Path, default=None, help="folder for uploads and exports (default: a temporary one)")
+
+
+def options_from_arguments(args) -> Options:
+    if args.segmentation is not None and args.ct is None:
+        raise SystemExit("--segmentation goes with --ct")
+    for name in ("navigate_scale", "drill_scale"):
+        value = getattr(args, name)
+        if not 0.05 <= value <= 1.0:
+            raise SystemExit(f"--{name.replace('_', '-')} {value}: give a fraction between 0.05 and 1")
+    if args.max_upload_mb <= 0:
+        raise SystemExit(f"--max-upload-mb {args.max_upload_mb}: give a positive size")
+    data_dirs = [Path(d).expanduser().resolve() for d in args.data_dir] or [headct.default_cache_dir().resolve()]
+    source = "phantom" if args.phantom else "own" if args.ct is not None else "headct"
+    return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
+                   max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
+                   work_dir=args.work_dir)
+
+
+def path_allowed(path: Path, folders) -> bool:
+    """Whether ``path`` (symbolic links resolved) lies inside one of ``folders``."""
+    resolved = Path(path).expanduser().resolve()
+    return any(resolved == folder or folder in resolved.parents for folder in folders)
+
+
+def unpack_upload(written: list[Path], folder: Path, max_bytes: int) -> Path:
+    """The path to load from uploaded files: the file, the folder of a series, or what a .zip holds.
+
+    A .zip is unpacked into ``folder``/unpacked, refusing members that would
+    land outside it and contents larger than ``max_bytes``.
+    """
+    if len(written) == 1 and written[0].suffix.lower() == ".zip":
+        archive = written[0]
+        with zipfile.ZipFile(archive) as bundle:
+            members = [member for member in bundle.infolist() if not member.is_dir()]
+            size = sum(member.file_size for member in members)
+            if size > max_bytes:
+                raise SessionError(f"{archive.name}: unpacked it holds {size / 2**20:.1f} MB, more than this server "
+                                   f"accepts ({max_bytes / 2**20:.1f} MB)")
+            target = (folder / "unpacked").resolve()
+            for member in members:
+                destination = (target / member.filename).resolve()
+                if target not in destination.parents:
+                    raise SessionError(f"{archive.name}: holds a path outside its folder ({member.filename}); not unpacked")
+            for member in members:
+                destination = target / member.filename
+                destination.parent.mkdir(parents=True, exist_ok=True)
+                destination.write_bytes(bundle.read(member))
+        archive.unlink()
+        unpacked = [path for path in target.rglob("*") if path.is_file()]
+        return unpacked[0] if len(unpacked) == 1 else target
+    return written[0] if len(written) == 1 else folder
+
+
+class ConnectionWatch(LinkProtocol):
+    """Tells the application when a browser tab connects or goes away (closed, reloaded, network lost)."""
+
+    def __init__(self, application):
+        super().__init__()
+        self._application = application
+
+    def onConnect(self, request, client_id):
+        self._application.client_connected(str(client_id))
+
+    def onClose(self, client_id):
+        self._application.client_closed(str(client_id))
+
+
+class VolumeCuttingApp(TrameApp):
+    """The application of one session (see the module's docstring)."""
+
+    def __init__(self, server=None, options: Options | None = None):
+        super().__init__(server)
+        self.options = options or Options()
+        self.server.enable_module(trame_slicer_module)
+        self.server.enable_module(CLIENT_MODULE)
+        self.slicer_app = SlicerApp()
+        logic = self.slicer_app.register_module_logic(slicer.vtkSlicerVolumeCuttingLogic(), logic_name="VolumeCutting")
+        self.session = DrillSession(self.slicer_app.scene, logic, self.options.work_dir)
+        self.drill = views.DrillController(self.session)
+        self.drill.on_stroke_begin = self._on_stroke_begin
+        self.drill.on_stroke_moved = self._on_stroke_moved
+        self.drill.on_stroke_end = self._on_stroke_end
+        self.drill.on_hover = lambda: self.progressive.pointer_moved()
+        self.drill.on_depth_changed = self._on_depth_changed
+        self._pipeline_creator = slicer.vtkMRMLLayerDMPipelineScriptedCreator()
+        self._pipeline_creator.SetPythonCallback(self._create_pipeline)
+        slicer.vtkMRMLLayerDMPipelineFactory.GetInstance().AddPipelineCreator(self._pipeline_creator)
+        self._contact_observer = None
+        self._observed_cut_node = None
+        self._clients: list[str] = []
+        self._upload_names: dict[str, str] = {}
+        self._last_table_refresh = 0.0
+        self._table_refresh_task = None
+        self.progressive = None
+        self.timing = {"events": deque(maxlen=20000), "renders": deque(maxlen=20000)}
+        self.server.add_protocol_to_configure(lambda protocol: protocol.registerLinkProtocol(ConnectionWatch(self)))
+        self._register_views()
+        self._initialize_state()
+        self._build_ui()
+        self._connect_three_d_view()
+
+    # ------------------------------------------------------------------ views
+
+    def _register_views(self) -> None:
+        manager = self.slicer_app.view_manager
+        common = dict(target_fps=60.0, blur_fps=5.0, interactive_quality=60, rca_event_throttle_s=0.01)
+        self._three_d_factory = rendering.ProgressiveThreeDViewFactory(self.server, populate_view_ui_f=self._three_d_view_ui,
+                                                                       **common)
+        manager.register_factory(self._three_d_factory)
+        manager.register_factory(RemoteViewFactory(self.server, views.VolumeCutSliceView, ViewType.SLICE_VIEW,
+                                                   populate_view_ui_f=create_vertical_slice_view_gutter_ui, **common))
+        self.layout_manager = LayoutManager(self.slicer_app.scene, manager, self.server)
+        three_d = ViewLayoutDefinition.threed_view(name=THREE_D_TAG)
+        slices = Layout(LayoutDirection.Vertical, [ViewLayoutDefinition.axial_view(), ViewLayoutDefinition.coronal_view(),
+                                                   ViewLayoutDefinition.sagittal_view()], flex_sizes=["1", "1", "1"])
+        self.layout_manager.register_layout(LAYOUT_ID, Layout(LayoutDirection.Horizontal, [three_d, slices],
+                                                              flex_sizes=["3", "1"]))
+        self.layout_manager.set_layout(LAYOUT_ID)
+
+    def _three_d_view_ui(self, server, view_id, view) -> None:
+        """Over the 3D view: camera buttons, and the contact warning with the view's red frame."""
+        with html.Div(classes="view-gutter", style="position: absolute; top: 0; left: 0; z-index: 2;"), \
+                html.Div(classes="d-flex flex-column pa-2"):
+            with v3.VBtn(size="small", variant="text", icon=True, click=self.reset_camera, raw_attrs=['data-testid="reset-camera"']):
+                v3.VIcon("mdi-camera-flip-outline", color="white")
+                v3.VTooltip("Look at the patient's right side", activator="parent", location="right")
+        # The view's area, for tests and benchmarks (it lets the mouse through).
+        html.Div(style="position: absolute; inset: 0; pointer-events: none;", raw_attrs=['data-testid="three-d-view"'])
+        html.Div(v_show="vc_contact", style="position: absolute; inset: 0; border: 4px solid #ff1a1a; pointer-events: none; z-index: 2;")
+        with html.Div(v_show="vc_contact", raw_attrs=['data-testid="contact-warning"'],
+                      style="position: absolute; top: 8px; left: 50%; transform: translateX(-50%); z-index: 3; "
+                            "background: #d50000; color: white; padding: 6px 14px; border-radius: 4px; "
+                            "font-weight: 600; pointer-events: none;"):
+            html.Span("{{ vc_contact }}")
+        html.Div("{{ vc_mode_hint }}", style="position: absolute; bottom: 8px; left: 12px; z-index: 2; color: white; "
+                 "text-shadow: 0 0 3px black; pointer-events: none; font-size: 13px;")
+
+    def _create_pipeline(self, view_node, display_node):
+        pipeline = self.drill.create_pipeline(view_node, display_node)
+        if pipeline is not None:
+            tag = view_node.GetSingletonTag()
+            previews = self._three_d_factory.previews
+            preview_of = tag[: -len(rendering.PREVIEW_SUFFIX)] if tag.endswith(rendering.PREVIEW_SUFFIX) else None
+            pipeline.view = previews.get(preview_of) if preview_of else self.slicer_app.view_manager.get_view(tag)
+        return pipeline
+
+    @property
+    def three_d_view(self) -> views.VolumeCutThreeDView:
+        return self.slicer_app.view_manager.get_view(THREE_D_TAG)
+
+    def _connect_three_d_view(self) -> None:
+        rca_view = self._three_d_factory.get_factory_view(THREE_D_TAG)
+        area = self._three_d_factory.areas[THREE_D_TAG]
+        self.progressive = rendering.ProgressiveRendering(area, self._three_d_factory.schedulers[THREE_D_TAG],
+                                                          self.options.navigate_scale, self.options.drill_scale,
+                                                          self.options.refine_delay_s)
+        self.drill.depth_sources = lambda: [area.main_view.surface_depth, area.preview_view.surface_depth]
+        adapter = rca_view.view_adapter
+        handle = adapter.on_interaction
+
+        def on_interaction(origin, event):
+            # Only the tab that owns the session steers it (see client_connected).
+            sender = self._sender()
+            if self._clients and sender and sender != self._clients[0]:
+                return
+            received = time.time() * 1000.0
+            handle(origin, event)
+            if TRACE:
+                print(f"[event] {event.get('type')} {time.time() * 1000.0 - received:.1f} ms", flush=True)
+            self.timing["events"].append((event.get("type", ""), received, time.time() * 1000.0,
+                                          event.get("x"), event.get("y")))
+
+        adapter.on_interaction = on_interaction
+        interactor = area.main_view.interactor()
+        for event in ("LeftButtonPressEvent", "MiddleButtonPressEvent", "RightButtonPressEvent"):
+            interactor.AddObserver(event, lambda *_: self.progressive.button_pressed(), 10.0)
+        for event in ("LeftButtonReleaseEvent", "MiddleButtonReleaseEvent", "RightButtonReleaseEvent"):
+            # Before the interactor style, which may take the event for itself.
+            interactor.AddObserver(event, lambda *_: self.progressive.button_released(), 10.0)
+        for name, window in (("main", area.main_view.render_window()), ("preview", area.preview_view.render_window())):
+            window.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: self._render_started())
+            window.AddObserver(vtk.vtkCommand.EndEvent, lambda w, _e, name=name: self._render_ended(name, w))
+        self.state.vc_three_d_area = get_view_trame_id(self.server, area.main_view)
+
+    def _render_started(self) -> None:
+        self._render_start = time.time() * 1000.0
+        self.timing["renders"].append(self._render_start)
+
+    def _render_ended(self, name, window) -> None:
+        if TRACE:
+            width, height = window.GetSize()
+            print(f"[render] {name} {width}x{height} {time.time() * 1000.0 - self._render_start:.0f} ms", flush=True)
+
+    def reset_camera(self) -> None:
+        if self.session.has_data:
+            self.three_d_view.look_from(self.session.volume_bounds(), (1.0, 0.0, 0.0))
+        for view in self.slicer_app.view_manager.get_slice_views():
+            view.fit_view_to_content()
+            view.schedule_render()
+
+    # ------------------------------------------------------------------ state
+
+    def _initialize_state(self) -> None:
+        state = self.state
+        state.trame__title = "VolumeCutting"
+        state.update({
+            "vc_source": self.options.source if self.options.source != "own" else "own",
+            "vc_source_items": SOURCE_ITEMS,
+            "vc_busy": False, "vc_progress": 0, "vc_status": "", "vc_error": "", "vc_warnings": [],
+            "vc_description": "",
+            "vc_ct_path": str(self.options.ct or ""), "vc_segmentation_path": str(self.options.segmentation or ""),
+            "vc_uploaded": {"ct": "", "segmentation": ""}, "vc_upload_message": "",
+            "vc_max_upload_bytes": self.options.max_upload_bytes,
+            "vc_data_dirs": [str(d) for d in self.options.data_dirs],
+            "vc_segments": [], "vc_role_items": ROLE_ITEMS, "vc_total_removed": 0.0,
+            "vc_presets": self.session.preset_names(), "vc_preset": None,
+            "vc_shapes": [s for s in toolconfig.SHAPES if s != "Mesh"], "vc_burr_types": list(toolconfig.BURR_TYPES),
+            "vc_tool": {}, "vc_tool_error": "", "vc_tool_ranges": self._tool_ranges("Sphere"),
+            "vc_mode": self.drill.mode, "vc_mode_hint": "", "vc_depth": self.drill.depth_mm,
+            "vc_undo_count": 0, "vc_redo_count": 0,
+            "vc_contact": "", "vc_contacts": [],
+            "vc_export_error": "", "vc_export_names": {},
+            "vc_owner": "", "vc_client_id": "",
+        })
+        state.client_only("vc_client_id")
+        self._update_mode_hint()
+
+    @staticmethod
+    def _tool_ranges(shape: str) -> dict:
+        ranges = dict(toolconfig.RANGES, diameter=toolconfig.diameter_range(shape))
+        return {name: [low, high] for name, (low, high) in ranges.items()}
+
+    def _refresh_after_data(self) -> None:
+        self._observe_cut_node()
+        self.slicer_app.display_manager.show_volume_in_slice_background(self.session.volume)
+        self.state.vc_description = self.session.description
+        self.state.vc_warnings = list(self.session.warnings)
+        base = "".join(c if c.isalnum() or c in "-_" else "_" for c in self.session.volume.GetName()) or "volume"
+        self.state.vc_export_names = {kind: f"{base}-{name}" for kind, (name, _) in EXPORT_FILES.items()}
+        self.state.vc_contact = ""
+        self._refresh_tool()
+        self._refresh_tables()
+        self.reset_camera()
+
+    def _refresh_tables(self) -> None:
+        rows = self.session.segment_rows()
+        self.state.vc_segments = [
+            {"id": r.segment_id, "name": r.name, "color": r.color, "role": r.role, "removed": round(r.removed_mm3, 2)}
+            for r in rows
+        ]
+        self.state.vc_total_removed = round(sum(r.removed_mm3 for r in rows), 2)
+        undo, redo = self.session.undo_redo_counts()
+        self.state.vc_undo_count, self.state.vc_redo_count = undo, redo
+        self.state.vc_contacts = self._contact_rows()
+        self._last_table_refresh = time.monotonic()
+
+    def _contact_rows(self) -> list[dict]:
+        if not self.session.has_data:
+            return []
+        table = self.session.logic.GetContactTableNode(self.session.cut_node).GetTable()
+        names = table.GetColumnByName("Name")
+        depths = table.GetColumnByName("Depth")
+        if names is None or depths is None:
+            return []
+        return [{"name": names.GetValue(row), "depth": round(float(depths.GetValue(row)), 2)}
+                for row in range(table.GetNumberOfRows())]
+
+    def _refresh_tool(self) -> None:
+        if not self.session.has_data:
+            return
+        params = self.session.tool_parameters()
+        self.state.vc_tool = {"shape": params.shape, "burr_type": params.burr_type, "diameter": params.diameter,
+                              "length": params.length, "thickness": params.thickness, "width": params.width,
+                              "power": params.power}
+        self.state.vc_tool_ranges = self._tool_ranges(params.shape)
+
+    def _observe_cut_node(self) -> None:
+        if self._observed_cut_node is not None and self._contact_observer is not None:
+            self._observed_cut_node.RemoveObserver(self._contact_observer)
+        self._observed_cut_node = self.session.cut_node
+        self._contact_observer = self.session.cut_node.AddObserver(slicer.vtkMRMLVolumeCutNode.ProtectedContactEvent,
+                                                                   self._on_contact)
+
+    def _on_contact(self, *_):
+        contact = self.session.contact()
+        if contact is None:
+            return
+        self.state.vc_contact = (f"Contact with {contact.name} ({'protected' if self.session.cut_node.IsSegmentProtected(contact.segment_id) else 'not cuttable by this tool'}): "
+                                 f"{contact.depth_mm:.2f} mm deep")
+        self.drill.set_glyph(in_contact=True)
+        self.state.flush()
+
+    # ------------------------------------------------------------------ drilling callbacks
+
+    def _on_stroke_begin(self) -> None:
+        self.progressive.stroke_started()
+        # The slice views follow the tool when the stroke ends; meanwhile the 3D view has the processor.
+        for view in self.slicer_app.view_manager.get_slice_views():
+            view.set_render_blocked(True)
+        self.state.vc_contact = ""
+        self.drill.set_glyph(in_contact=False)
+
+    def _on_stroke_moved(self) -> None:
+        # The removed volume follows live, a few times a second.
+        if time.monotonic() - self._last_table_refresh > 0.25:
+            self.session.update_removed_volumes()
+            self._refresh_tables()
+
+    def _on_stroke_end(self) -> None:
+        self.progressive.stroke_ended()
+        self._refresh_tables()
+        self._jump_slices_to_tool()
+        for view in self.slicer_app.view_manager.get_slice_views():
+            view.set_render_blocked(False)
+
+    def _jump_slices_to_tool(self) -> None:
+        """The slice views go through the tool's centre, where the cut was just made."""
+        transform = self.session.tool_node.GetParentTransformNode() if self.session.has_data else None
+        if transform is None:
+            return
+        pose = vtk.vtkMatrix4x4()
+        transform.GetMatrixTransformToWorld(pose)
+        slicer.vtkMRMLSliceNode.JumpAllSlices(self.slicer_app.scene, pose.GetElement(0, 3), pose.GetElement(1, 3),
+                                              pose.GetElement(2, 3), slicer.vtkMRMLSliceNode.OffsetJumpSlice)
+
+    def _undo_redo(self, step) -> None:
+        """Undo or redo a stroke; a contact warning belonged to the stroke that was drawn last."""
+        if not self.session.has_data:
+            return
+        step()
+        self.state.vc_contact = ""
+        self.drill.set_glyph(in_contact=False)
+        self._refresh_tables()
+
+    def _on_depth_changed(self, depth: float) -> None:
+        self.state.vc_depth = depth
+
+    def _update_mode_hint(self) -> None:
+        hints = {
+            views.MODE_NAVIGATE: "Navigate: drag to rotate, right-drag to zoom, middle-drag to pan",
+            views.MODE_DRILL: "Drill: press and drag on the bone; wheel sets the depth, Shift drills twice as deep",
+            views.MODE_RESTORE: "Restore: press and drag to add bone back inside the cut",
+        }
+        self.state.vc_mode_hint = hints[self.drill.mode] + f" (depth {self.drill.depth_mm:.2f} mm)"
+
+    # ------------------------------------------------------------------ tabs and connections
+
+    def client_connected(self, client_id: str) -> None:
+        if client_id not in self._clients:
+            self._clients.append(client_id)
+        self._publish_owner()
+
+    def client_closed(self, client_id: str) -> None:
+        was_owner = bool(self._clients) and self._clients[0] == client_id
+        if client_id in self._clients:
+            self._clients.remove(client_id)
+        if was_owner:
+            # The page went away mid-stroke (closed, reloaded, network lost): the stroke ends, the cut stays.
+            if self.drill.end_stroke():
+                self._refresh_tables()
+        self._publish_owner()
+
+    def _sender(self) -> str:
+        """The connection whose message is being handled (wslink keeps it on its web server)."""
+        web_server = getattr(self.server, "_server", None)
+        sender = getattr(web_server, "last_active_client_id", None)
+        return str(sender) if sender is not None else ""
+
+    def _publish_owner(self) -> None:
+        with self.state:
+            self.state.vc_owner = self._clients[0] if self._clients else ""
+
+    # ------------------------------------------------------------------ controller
+
+    def _bind(self) -> None:
+        ctrl, state = self.ctrl, self.state
+
+        @ctrl.trigger("vc_hello")
+        def hello():
+            return self._sender()
+
+        @ctrl.trigger("vc_take_over")
+        def take_over():
+            sender = self._sender()
+            self.drill.end_stroke()
+            if sender in self._clients:
+                self._clients.remove(sender)
+            self._clients.insert(0, sender)
+            self._publish_owner()
+
+        @ctrl.trigger("vc_diagnostics")
+        def diagnostics():
+            # For tests and benchmarks: what the server did and which mode it is in.
+            return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]), "mode": self.drill.mode}
+
+        @ctrl.trigger("vc_load")
+        async def load(source):
+            await self.load_from_panel(source)
+
+        @ctrl.trigger("vc_upload")
+        def upload(kind, files):
+            self.receive_upload(kind, files)
+
+        @ctrl.trigger("vc_set_role")
+        def set_role(segment_id, role):
+            try:
+                self.session.set_role(segment_id, role)
+            except SessionError as error:
+                state.vc_error = str(error)
+            self._refresh_tables()
+
+        @ctrl.trigger("vc_preset")
+        def apply_preset(name):
+            try:
+                self.session.apply_preset(name)
+                state.vc_tool_error = ""
+            except (SessionError, toolconfig.ToolConfigError) as error:
+                state.vc_tool_error = str(error)
+            self._refresh_tool()
+
+        @ctrl.trigger("vc_set_tool")
+        def set_tool(name, value):
+            try:
+                value = value if name in ("shape", "burr_type") else float(value)
+                self.session.set_tool(**{name: value})
+                state.vc_tool_error = ""
+            except (SessionError, toolconfig.ToolConfigError, ValueError, TypeError) as error:
+                state.vc_tool_error = f"{name}: {error}" if not str(error).startswith(name) else str(error)
+            self._refresh_tool()
+
+        @ctrl.trigger("vc_undo")
+        def undo():
+            self._undo_redo(self.session.undo)
+
+        @ctrl.trigger("vc_redo")
+        def redo():
+            self._undo_redo(self.session.redo)
+
+        @ctrl.trigger("vc_export")
+        def export(kind):
+            try:
+                path = self.session.export(kind)
+            except SessionError as error:
+                state.vc_export_error = str(error)
+                return None
+            state.vc_export_error = ""
+            return self.server.protocol.addAttachment(path.read_bytes())
+
+        @state.change("vc_mode")
+        def mode_changed(vc_mode, **_):
+            try:
+                self.drill.set_mode(vc_mode)
+            except ValueError:
+                state.vc_mode = self.drill.mode
+            self._update_mode_hint()
+
+        @state.change("vc_depth")
+        def depth_changed(vc_depth, **_):
+            try:
+                depth = self.drill.set_depth(vc_depth)
+            except (ValueError, TypeError):
+                depth = self.drill.depth_mm
+            if depth != vc_depth:
+                state.vc_depth = depth
+            self._update_mode_hint()
+
+    # ------------------------------------------------------------------ data
+
+    async def load_from_panel(self, source: str) -> None:
+        """The Data panel's Load button: own data comes from an upload or an allowed server path."""
+        try:
+            options = self._own_data_paths() if source == "own" else {}
+        except (SessionError, owndata.InputError) as error:
+            self.state.vc_error = str(error)
+            return
+        await self.load(source, **options)
+
+    async def load(self, source: str, **options) -> None:
+        """Load data with progress in the page; what cannot be loaded leaves the scene as it was."""
+        state = self.state
+        if state.vc_busy:
+            return
+        with state:
+            state.vc_busy, state.vc_error, state.vc_progress, state.vc_status = True, "", 0, "Starting"
+        self.drill.end_stroke()
+        try:
+            for fraction, text in self.session.loading(source, **options):
+                with state:
+                    state.vc_progress, state.vc_status = round(100 * fraction), text
+                # Let the page show the progress before the next step holds the server.
+                await asyncio.sleep(0.05)
+            self._refresh_after_data()
+            state.vc_status = "Ready: " + self.session.description
+            state.vc_upload_message = ""  # a refused upload's message no longer applies to the data shown
+        except (SessionError, owndata.InputError, headct.HeadCTUnavailableError, OSError) as error:
+            state.vc_error = self._with_upload_names(str(error))
+            state.vc_status = "Not loaded; the previous data stays" if self.session.has_data else "Not loaded"
+        finally:
+            with state:
+                state.vc_busy = False
+
+    def _with_upload_names(self, text: str) -> str:
+        """Messages name uploaded files as the user named them, not by where the server keeps them."""
+        for path, name in sorted(self._upload_names.items(), key=lambda item: -len(item[0])):
+            text = text.replace(path, f"{name} (uploaded)")
+        return text
+
+    def _own_data_paths(self) -> dict:
+        """The CT and segmentation to load: the uploaded ones, else the server paths (checked against the allowed folders)."""
+        uploaded = self.state.vc_uploaded or {}
+        paths = {}
+        for key, upload_key, state_key in (("ct_path", "ct", "vc_ct_path"), ("segmentation_path", "segmentation", "vc_segmentation_path")):
+            if uploaded.get(upload_key):
+                paths[key] = Path(uploaded[upload_key])
+                continue
+            text = (self.state[state_key] or "").strip()
+            if not text:
+                continue
+            path = Path(text).expanduser()
+            if not path.is_absolute():
+                raise SessionError(f"{text}: give the full path of the file or folder on the server")
+            if not path_allowed(path, self.options.data_dirs):
+                folders = ", ".join(str(d) for d in self.options.data_dirs)
+                raise SessionError(f"{path}: this server only reads files inside {folders}. Copy the scan there, "
+                                   "upload it instead, or ask the administrator to start the app with --data-dir")
+            paths[key] = path
+        if "ct_path" not in paths:
+            raise SessionError("Give the CT: upload it, or type its path on the server")
+        return paths
+
+    def receive_upload(self, kind: str, files) -> None:
+        """Store uploaded files (a file, a DICOM series as several files, or a .zip of either) for the next load."""
+        state = self.state
+        if kind not in ("ct", "segmentation"):
+            state.vc_upload_message = f"Unknown upload {kind!r}"
+            return
+        files = files if isinstance(files, list) else [files]
+        total = sum(len(f.get("content") or b"") for f in files)
+        if total > self.options.max_upload_bytes:
+            state.vc_upload_message = (f"{total / 2**20:.1f} MB is more than this server accepts "
+                                       f"({self.options.max_upload_mb:.1f} MB)")
+            return
+        folder = self.session.work_directory / "uploads" / f"{kind}-{time.time_ns()}"
+        folder.mkdir(parents=True)
+        written = []
+        for item in files:
+            name = Path(str(item.get("name") or "upload")).name
+            if not name or name in (".", ".."):
+                name = "upload"
+            path = folder / name
+            path.write_bytes(item.get("content") or b"")
+            written.append(path)
+        try:
+            target = unpack_upload(written, folder, self.options.max_upload_bytes)
+        except (zipfile.BadZipFile, SessionError) as error:
+            state.vc_upload_message = str(error)
+            return
+        names = [Path(str(item.get("name") or "upload")).name for item in files]
+        self._upload_names[str(target)] = names[0] if len(names) == 1 else f"{len(names)} files ({names[0]}, ...)"
+        uploaded = dict(state.vc_uploaded or {})
+        uploaded[kind] = str(target)
+        state.vc_uploaded = uploaded
+        state.vc_upload_message = ""
+
+    # ------------------------------------------------------------------ page
+
+    def _build_ui(self) -> None:
+        self._bind()
+        with SinglePageWithDrawerLayout(self.server, full_height=True) as layout:
+            self.ui = layout
+            layout.title.set_text("VolumeCutting")
+            client.ClientTriggers(mounted="trigger('vc_hello').then((id) => { vc_client_id = id })")
+            with layout.toolbar:
+                v3.VSpacer()
+                with v3.VBtnToggle(v_model=("vc_mode",), mandatory=True, density="compact", classes="mr-2",
+                                   raw_attrs=['data-testid="mode"']):
+                    v3.VBtn("Navigate", value=views.MODE_NAVIGATE, prepend_icon="mdi-rotate-3d-variant", raw_attrs=['data-testid="mode-navigate"'])
+                    v3.VBtn("Drill", value=views.MODE_DRILL, prepend_icon="mdi-screw-machine-flat-top", raw_attrs=['data-testid="mode-drill"'])
+                    v3.VBtn("Restore", value=views.MODE_RESTORE, prepend_icon="mdi-bandage", raw_attrs=['data-testid="mode-restore"'])
+                v3.VBtn(icon="mdi-undo", click="trigger('vc_undo')", disabled=("vc_undo_count === 0",), raw_attrs=['data-testid="undo"'])
+                v3.VBtn(icon="mdi-redo", click="trigger('vc_redo')", disabled=("vc_redo_count === 0",), raw_attrs=['data-testid="redo"'])
+            with layout.drawer as drawer:
+                drawer.width = 380
+                self._panels()
+            with layout.content:
+                with html.Div(style="position: relative; width: 100%; height: 100%;"):
+                    with html.Div(style="position: absolute; inset: 0;"):
+                        self.layout_manager.initialize_layout_grid(layout)
+                    self._tab_overlay()
+
+    def _tab_overlay(self) -> None:
+        with v3.VOverlay(model_value=("vc_owner && vc_client_id && vc_owner !== vc_client_id",), persistent=True,
+                         contained=False, classes="align-center justify-center", raw_attrs=['data-testid="tab-overlay"']):
+            with v3.VCard(max_width=520, classes="pa-4"):
+                v3.VCardTitle("This session is open in another tab")
+                v3.VCardText("One drilling session follows one tab at a time, so that strokes from two places do not "
+                             "mix. Everything done so far is kept on the server; the views here follow it.")
+                with v3.VCardActions():
+                    v3.VSpacer()
+                    v3.VBtn("Drill from this tab", color="primary", click="trigger('vc_take_over')", raw_attrs=['data-testid="take-over"'])
+
+    def _panels(self) -> None:
+        with v3.VExpansionPanels(multiple=True, model_value=("vc_panels", ["data", "segments", "tool", "drill", "export"]),
+                                 variant="accordion"):
+            self._data_panel()
+            self._segments_panel()
+            self._tool_panel()
+            self._drill_panel()
+            self._export_panel()
+
+    def _data_panel(self) -> None:
+        with v3.VExpansionPanel(value="data", title="Data"), v3.VExpansionPanelText():
+            v3.VSelect(v_model=("vc_source",), items=("vc_source_items",), label="Scan", density="compact",
+                       hide_details=True, raw_attrs=['data-testid="source"'])
+            with html.Div(v_if="vc_source === 'own'", classes="mt-2"):
+                v3.VFileInput(label="CT: upload (DICOM files, .zip, .nrrd, .nii, .nii.gz, .mha)", multiple=True,
+                              density="compact", hide_details=True, raw_attrs=['data-testid="upload-ct"'],
+                              update_modelValue="vc_upload_message = utils.vc.upload('ct', $event, vc_max_upload_bytes)")
+                v3.VTextField(v_model=("vc_ct_path",), label="... or its path on the server", density="compact",
+                              hide_details=True, classes="mt-1", raw_attrs=['data-testid="ct-path"'])
+                v3.VFileInput(label="Segmentation (optional): .seg.nrrd or labelmap", density="compact",
+                              hide_details=True, classes="mt-2", raw_attrs=['data-testid="upload-segmentation"'],
+                              update_modelValue="vc_upload_message = utils.vc.upload('segmentation', $event, vc_max_upload_bytes)")
+                v3.VTextField(v_model=("vc_segmentation_path",), label="... or its path on the server",
+                              density="compact", hide_details=True, classes="mt-1", raw_attrs=['data-testid="segmentation-path"'])
+                html.Div("Server folders: {{ vc_data_dirs.join(', ') }}", classes="text-caption mt-1")
+                v3.VAlert(v_if="vc_upload_message", text=("vc_upload_message",), type="error", density="compact",
+                          classes="mt-2", raw_attrs=['data-testid="upload-message"'])
+                html.Div(v_if="vc_uploaded.ct", classes="text-caption",
+                         children=["Uploaded CT ready: {{ vc_uploaded.ct.split('/').pop() }}"])
+            v3.VBtn("Load", block=True, color="primary", classes="mt-2", click="trigger('vc_load', [vc_source])",
+                    disabled=("vc_busy",), raw_attrs=['data-testid="load"'])
+            v3.VProgressLinear(v_show="vc_busy", model_value=("vc_progress",), height=6, classes="mt-2", color="primary",
+                               raw_attrs=['data-testid="progress"'])
+            html.Div("{{ vc_status }}", classes="text-caption mt-1", raw_attrs=['data-testid="status"'])
+            v3.VAlert(v_if="vc_error", text=("vc_error",), type="error", density="compact", classes="mt-2",
+                      raw_attrs=['data-testid="data-error"'])
+            with html.Div(v_for="w in vc_warnings", classes="text-caption text-warning"):
+                html.Span("{{ w }}")
+
+    def _segments_panel(self) -> None:
+        with v3.VExpansionPanel(value="segments", title="Segments"), v3.VExpansionPanelText():
+            with v3.VTable(density="compact", raw_attrs=['data-testid="segments"'], style="font-size: 13px"):
+                with html.Thead(), html.Tr():
+                    html.Th("Segment", style="padding: 0 4px")
+                    html.Th("Role", style="padding: 0 4px")
+                    html.Th("Removed mm³", classes="text-right", style="padding: 0 4px")
+                with html.Tbody():
+                    with html.Tr(v_for="s in vc_segments", key="s.id", raw_attrs=[':data-segment="s.id"']):
+                        with html.Td(style="padding: 0 4px; word-break: break-word"):
+                            html.Span(style=("{ display: 'inline-block', width: '10px', height: '10px', marginRight: '6px', "
+                                             "borderRadius: '2px', background: s.color }",))
+                            html.Span("{{ s.name }}")
+                        with html.Td(style="padding: 0 4px; width: 112px"):
+                            v3.VSelect(model_value=("s.role",), items=("vc_role_items",), density="compact",
+                                       variant="plain", hide_details=True, raw_attrs=[':data-role-of="s.id"'],
+                                       style="font-size: 13px",
+                                       update_modelValue="trigger('vc_set_role', [s.id, $event])")
+                        html.Td("{{ s.removed.toFixed(2) }}", classes="text-right", style="padding: 0 4px",
+                                raw_attrs=[':data-removed-of="s.id"'])
+            html.Div("Removed in all: {{ vc_total_removed.toFixed(2) }} mm³", classes="text-body-2 mt-1",
+                     raw_attrs=['data-testid="total-removed"'])
+
+    def _tool_panel(self) -> None:
+        with v3.VExpansionPanel(value="tool", title="Tool"), v3.VExpansionPanelText():
+            v3.VSelect(model_value=("vc_preset",), items=("vc_presets",), label="Preset", density="compact",
+                       hide_details=True, raw_attrs=['data-testid="preset"'],
+                       update_modelValue="vc_preset = $event; trigger('vc_preset', [$event])")
+            v3.VSelect(model_value=("vc_tool.shape",), items=("vc_shapes",), label="Shape", density="compact",
+                       hide_details=True, classes="mt-2", raw_attrs=['data-testid="shape"'],
+                       update_modelValue="trigger('vc_set_tool', ['shape', $event])")
+            v3.VSelect(v_if="['Sphere', 'Cylinder'].includes(vc_tool.shape)", model_value=("vc_tool.burr_type",),
+                       items=("vc_burr_types",), label="Burr", density="compact", hide_details=True, classes="mt-2",
+                       update_modelValue="trigger('vc_set_tool', ['burr_type', $event])")
+            for name, label, shapes in (("diameter", "Diameter (mm)", "['Sphere', 'Cylinder', 'DiskSaw']"),
+                                        ("length", "Length (mm)", "['Cylinder', 'Blade']"),
+                                        ("width", "Width (mm)", "['Blade']"),
+                                        ("thickness", "Thickness (mm)", "['DiskSaw', 'Blade']")):
+                v3.VTextField(v_if=f"{shapes}.includes(vc_tool.shape)", model_value=(f"vc_tool.{name}",), label=label,
+                              type="number", step=0.5, density="compact", hide_details=True, classes="mt-2",
+                              hint=(f"`${{vc_tool_ranges.{name}[0]}} to ${{vc_tool_ranges.{name}[1]}} mm`",),
+                              raw_attrs=[f'data-testid="tool-{name}"'],
+                              change=f"trigger('vc_set_tool', ['{name}', $event.target.value])")
+            v3.VSlider(model_value=("vc_tool.power",), min=0, max=1, step=0.05, label="Power", density="compact",
+                       hide_details=True, classes="mt-2", thumb_label=True,
+                       end="trigger('vc_set_tool', ['power', $event])")
+            html.Div("Power drives rate-based removal (haptic drilling); mouse strokes remove what the tool sweeps.",
+                     classes="text-caption")
+            v3.VAlert(v_if="vc_tool_error", text=("vc_tool_error",), type="error", density="compact", classes="mt-2",
+                      raw_attrs=['data-testid="tool-error"'])
+
+    def _drill_panel(self) -> None:
+        with v3.VExpansionPanel(value="drill", title="Drill"), v3.VExpansionPanelText():
+            v3.VSlider(v_model=("vc_depth",), min=views.DEPTH_RANGE_MM[0], max=views.DEPTH_RANGE_MM[1],
+                       step=views.DEPTH_STEP_MM, label="Depth (mm)", thumb_label="always", density="compact",
+                       hide_details=True, raw_attrs=['data-testid="depth"'])
+            html.Div("Press and drag on the bone in Drill mode. The wheel changes the depth; "
+                     "hold Shift to drill twice as deep. Restore mode adds bone back.", classes="text-caption")
+            html.Div("Undo steps: {{ vc_undo_count }}, redo steps: {{ vc_redo_count }}", classes="text-caption mt-1")
+            with html.Div(v_if="vc_contacts.length", classes="mt-2", raw_attrs=['data-testid="contacts"']):
+                # The logic's contact table is a record of the session: undo takes the cut back, not the contact.
+                html.Div("Touched so far (structures the tool may not cut; undo keeps this record):",
+                         classes="text-body-2 text-error")
+                with html.Div(v_for="(c, i) in vc_contacts", key="i", classes="text-caption"):
+                    html.Span("{{ c.name }}: {{ c.depth.toFixed(2) }} mm")
+
+    def _export_panel(self) -> None:
+        with v3.VExpansionPanel(value="export", title="Export"), v3.VExpansionPanelText():
+            for kind, label, icon in (("stl", "Removed region (STL)", "mdi-cube-outline"),
+                                      ("segmentation", "Removed segment (.seg.nrrd)", "mdi-shape-outline"),
+                                      ("drilled_ct", "Drilled CT (.nrrd)", "mdi-file-image-outline"),
+                                      ("scene", "Scene (.mrb)", "mdi-package-variant-closed")):
+                mime = EXPORT_FILES[kind][1]
+                v3.VBtn(label, block=True, variant="tonal", classes="mb-1", prepend_icon=icon, raw_attrs=[f'data-testid="export-{kind}"'],
+                        click=f"trigger('vc_export', ['{kind}']).then((content) => content && "
+                              f"utils.download(vc_export_names['{kind}'], content, '{mime}'))")
+            v3.VAlert(v_if="vc_export_error", text=("vc_export_error",), type="error", density="compact", classes="mt-2",
+                      raw_attrs=['data-testid="export-error"'])
+
+
+def main(argv=None) -> int:
+    from trame.app import get_server
+
+    server = get_server(client_type="vue3")
+    add_arguments(server.cli)
+    args, _ = server.cli.parse_known_args(argv)
+    options = options_from_arguments(args)
+    app = VolumeCuttingApp(server, options)
+    paths = {"ct_path": options.ct, "segmentation_path": options.segmentation} if options.source == "own" else {}
+
+    def load_at_start(**_):
+        # The data loads while the page opens: the page shows the progress.
+        create_task(app.load(options.source, **paths))
+
+    server.controller.on_server_ready.add(load_at_start)
+    server.start(open_browser=False)
+    return 0
