@@ -181,13 +181,15 @@ def test_undo_restores_the_previous_image_and_volumes(app, shots):
     after = app.three_d_pixels()
     before = shared["image"]
     # The bottom line of the view is the mode hint, which names the depth (changed since).
+    # Frames are JPEG: the same image encoded twice differs by up to ~70 (summed over RGB) in the bone's texture;
+    # the undone stroke differs by hundreds over about 1 % of the view.
     difference = np.abs(after.astype(int) - before.astype(int)).sum(axis=2)[:-36]
-    if (difference > 30).mean() >= 0.001:
+    if (difference > 100).mean() >= 0.001:
         from PIL import Image
 
         Image.fromarray(before).save(shots / "undo-before.png")
         Image.fromarray(after).save(shots / "undo-after.png")
-    assert (difference > 30).mean() < 0.001, f"{(difference > 30).mean():.2%} of the view differs after undo"
+    assert (difference > 100).mean() < 0.001, f"{(difference > 100).mean():.2%} of the view differs after undo"
     app.screenshot(shots / "05-undone.png")
     app.testid("redo").click()
     app.wait_for(f"""() => parseFloat(document.querySelector('[data-removed-of="MastoidCortex"]').textContent)
