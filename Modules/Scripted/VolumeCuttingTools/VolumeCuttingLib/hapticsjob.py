@@ -21,7 +21,7 @@ import numpy as np
 import slicer
 import vtk
 
-from . import toolconfig
+from . import recording, toolconfig
 
 #: The tool the session drills with.
 BURR_PRESET = "Cutting burr 4 mm"
@@ -125,9 +125,14 @@ def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
     surface, direction, where = target_beside(cut_node, plan)
     start = surface - STANDOFF_MM * direction
     tool, created = active_burr(scene, cut_node)
+    # The handpiece held along the approach, shaft outwards: a 3-DOF device
+    # moves the tool and keeps this orientation.
     pose = vtk.vtkMatrix4x4()
-    for axis in range(3):
-        pose.SetElement(axis, 3, float(start[axis]))
+    rotation = recording.frame_along(direction)
+    for row in range(3):
+        for column in range(3):
+            pose.SetElement(row, column, float(rotation[row, column]))
+        pose.SetElement(row, 3, float(start[row]))
     tool.GetParentTransformNode().SetMatrixTransformToParent(pose)
 
     # The recording: device input only (what a device gives), with the

@@ -250,6 +250,12 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         raise RuntimeError("writing removed.stl failed (see the log)")
     drilled_ct = logic.ExportDrilledVolume(cut_node, -1000.0, None)
 
+    # The stills show the bone: the drills are lifted out of the picture.
+    tool_nodes = application.scene.GetNodesByClass("vtkMRMLVolumeCutToolNode")
+    for index in range(tool_nodes.GetNumberOfItems()):
+        tool_display = tool_nodes.GetItemAsObject(index).GetDisplayNode()
+        if tool_display is not None:
+            tool_display.SetVisibility(False)
     with timer.measure("cut_frame_s"):
         view.render()
     image_path = view.screenshot(out_dir / "3d.png")

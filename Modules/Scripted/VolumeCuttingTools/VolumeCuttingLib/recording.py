@@ -32,7 +32,7 @@ class RecordingError(ValueError):
     """A recording file that cannot be used; the message names the file and what is wrong."""
 
 
-def _frame_along(direction) -> np.ndarray:
+def frame_along(direction) -> np.ndarray:
     """A rotation whose +z points back along ``direction`` (the shaft, towards the handpiece)."""
     z = -np.asarray(direction, dtype=float)
     z /= np.linalg.norm(z)
@@ -51,7 +51,7 @@ def record_mastoidectomy(plan, cutting_tool="cutting", finishing_tool="diamond",
     ``plan`` is a ``drilling.MastoidectomyPlan``; the tool keys name the
     tools the replay is given.
     """
-    rotation = _frame_along(plan.direction)
+    rotation = frame_along(plan.direction)
     layers = {}
     for poses in plan.strokes():
         # Strokes of one layer share the burr depth along the approach direction.
