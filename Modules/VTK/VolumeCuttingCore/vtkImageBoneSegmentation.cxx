@@ -156,6 +156,75 @@ int vtkImageBoneSegmentation::RequestData(
       }
     }
   }
+  if (this->BoundaryIsCortical)
+  {
+    // The partial-volume shell, cortex by the paper's model: grown voxels
+    // with a face neighbour outside the bone, then, inwards, grown voxels on
+    // the rising ramp from such a voxel to the cortex (a face neighbour in
+    // the shell with a lower value, and a cortical one), as the shell is two
+    // voxels thick where the boundary falls near a voxel's edge. Each layer
+    // is found before it is relabelled, so that the shell does not spread
+    // further inwards.
+    auto faceNeighbors = [&](vtkIdType index, vtkIdType neighbors[6]) {
+      const vtkIdType k = index / sliceSize;
+      const vtkIdType j = (index - k * sliceSize) / dims[0];
+      const vtkIdType i = index - k * sliceSize - j * dims[0];
+      neighbors[0] = i > 0 ? index - 1 : -1;
+      neighbors[1] = i + 1 < dims[0] ? index + 1 : -1;
+      neighbors[2] = j > 0 ? index - dims[0] : -1;
+      neighbors[3] = j + 1 < dims[1] ? index + dims[0] : -1;
+      neighbors[4] = k > 0 ? index - sliceSize : -1;
+      neighbors[5] = k + 1 < dims[2] ? index + sliceSize : -1;
+    };
+    const size_t firstGrown = static_cast<size_t>(this->NumberOfCorticalVoxels);
+    std::vector<unsigned char> inShell(static_cast<size_t>(voxelCount), 0);
+    std::vector<vtkIdType> layer;
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      vtkIdType neighbors[6];
+      faceNeighbors(queue[head], neighbors);
+      if (std::any_of(neighbors, neighbors + 6, [&](vtkIdType n) { return n >= 0 && labels[n] == BackgroundLabel; }))
+      {
+        layer.push_back(queue[head]);
+      }
+    }
+    for (vtkIdType index : layer)
+    {
+      inShell[index] = 1;
+    }
+    std::vector<vtkIdType> ramp;
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      const vtkIdType index = queue[head];
+      vtkIdType neighbors[6];
+      faceNeighbors(index, neighbors);
+      bool lowerShell = false;
+      bool cortex = false;
+      for (vtkIdType n : neighbors)
+      {
+        lowerShell |= n >= 0 && inShell[n] && values[n] < values[index];
+        cortex |= n >= 0 && labels[n] == CorticalLabel;
+      }
+      if (!inShell[index] && lowerShell && cortex)
+      {
+        ramp.push_back(index);
+      }
+    }
+    for (vtkIdType index : ramp)
+    {
+      inShell[index] = 1;
+    }
+    const vtkIdType relabelled = static_cast<vtkIdType>(layer.size() + ramp.size());
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      if (inShell[queue[head]])
+      {
+        labels[queue[head]] = CorticalLabel;
+      }
+    }
+    this->NumberOfCorticalVoxels += relabelled;
+    this->NumberOfTrabecularVoxels -= relabelled;
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -167,6 +236,7 @@ void vtkImageBoneSegmentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CorticalThreshold: " << this->CorticalThreshold << "\n";
   os << indent << "TrabecularThreshold: " << this->TrabecularThreshold << "\n";
   os << indent << "SmoothingStandardDeviation: " << this->SmoothingStandardDeviation << "\n";
+  os << indent << "BoundaryIsCortical: " << this->BoundaryIsCortical << "\n";
   os << indent << "NumberOfCorticalVoxels: " << this->NumberOfCorticalVoxels << "\n";
   os << indent << "NumberOfTrabecularVoxels: " << this->NumberOfTrabecularVoxels << "\n";
 }

@@ -93,7 +93,7 @@ public:
             this->Shader.Shade(rgb, normal, ray.View, shaded);
             // Depth and normal belong to the first piece that clearly shows
             // (a cut surface is a surface: its first piece always counts).
-            result.Record(ray, start, source, normal, shaded, alpha, lastCutBorder >= 0 ? 0.f : 0.02f);
+            result.Record(ray, start, source, 0, normal, shaded, alpha, lastCutBorder >= 0 ? 0.f : 0.02f);
             if (result.Opaque())
             {
               return true;

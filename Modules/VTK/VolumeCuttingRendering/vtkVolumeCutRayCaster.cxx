@@ -104,6 +104,7 @@ struct vtkVolumeCutRayCaster::Internals
   std::vector<float> Depth;
   std::vector<float> Normal;
   std::vector<int> Source;
+  std::vector<int> Segment;
   bool ImageValid = false;
 
   void CastRay(int x, int y, const double* opaqueLimit);
@@ -121,11 +122,13 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
   result.Depth = &this->Depth[pixel];
   result.Normal = &this->Normal[3 * pixel];
   result.Source = &this->Source[pixel];
+  result.Segment = &this->Segment[pixel];
   result.WorldToNDC = this->WorldToNDC;
   std::fill(result.Color, result.Color + 4, 0.f);
   *result.Depth = 1.f;
   std::fill(result.Normal, result.Normal + 3, 0.f);
   *result.Source = SourceNone;
+  *result.Segment = 0;
 
   // The ray through the pixel's centre, from the near to the far plane.
   const double ndcX = 2.0 * (x + 0.5) / this->Width - 1.0;
@@ -433,6 +436,10 @@ const int* vtkVolumeCutRayCaster::GetSourceBuffer() const
 {
   return this->Impl->Source.empty() ? nullptr : this->Impl->Source.data();
 }
+const int* vtkVolumeCutRayCaster::GetSegmentBuffer() const
+{
+  return this->Impl->Segment.empty() ? nullptr : this->Impl->Segment.data();
+}
 
 namespace
 {
@@ -468,6 +475,10 @@ void vtkVolumeCutRayCaster::GetNormalImage(vtkImageData* image) const
 void vtkVolumeCutRayCaster::GetSourceImage(vtkImageData* image) const
 {
   FillImage<vtkIntArray>(image, this->Impl->Width, this->Impl->Height, 1, this->Impl->Source);
+}
+void vtkVolumeCutRayCaster::GetSegmentImage(vtkImageData* image) const
+{
+  FillImage<vtkIntArray>(image, this->Impl->Width, this->Impl->Height, 1, this->Impl->Segment);
 }
 
 namespace
@@ -920,6 +931,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     impl.Depth.assign(pixels, 1.f);
     impl.Normal.assign(3 * pixels, 0.f);
     impl.Source.assign(pixels, SourceNone);
+    impl.Segment.assign(pixels, 0);
   }
 
   // Which pixels to cast: all, or those covering bricks changed since the last image.

@@ -202,18 +202,21 @@ public:
   /**
    * Results of the last Render (width x height, row 0 at the bottom):
    * premultiplied RGBA (4 floats a pixel), window depth of the first visible
-   * surface (1 where none), its world normal (3 floats, 0 where none), and
-   * which border it is: SourceNone, SourceObject, SourceVolumeBox,
-   * SourceClipPlane or SourceCutField + the cut field's index.
+   * surface (1 where none), its world normal (3 floats, 0 where none),
+   * which border it is (SourceNone, SourceObject, SourceVolumeBox,
+   * SourceClipPlane or SourceCutField + the cut field's index) and which
+   * segment's material it shows (its label; 0 where none and in composite mode).
    */
   const float* GetColorBuffer() const;
   const float* GetDepthBuffer() const;
   const float* GetNormalBuffer() const;
   const int* GetSourceBuffer() const;
+  const int* GetSegmentBuffer() const;
   void GetColorImage(vtkImageData* image) const;
   void GetDepthImage(vtkImageData* image) const;
   void GetNormalImage(vtkImageData* image) const;
   void GetSourceImage(vtkImageData* image) const;
+  void GetSegmentImage(vtkImageData* image) const;
   ///@}
 
   enum SurfaceSources

@@ -6,8 +6,8 @@
  * @brief   What one ray of vtkVolumeCutRayCaster accumulates, written into its pixel.
  *
  * Premultiplied colour composited front to back, and, for the first layer
- * that clearly shows, its window depth, world normal and source (which
- * border forms it).
+ * that clearly shows, its window depth, world normal, source (which border
+ * forms it) and segment (whose material it is).
  */
 #ifndef vtkVolumeCutRayResult_h
 #define vtkVolumeCutRayResult_h
@@ -25,13 +25,15 @@ struct vtkVolumeCutRayResult
   float* Depth = nullptr;  // 1
   float* Normal = nullptr; // 3
   int* Source = nullptr;   // 1
+  int* Segment = nullptr;  // 1
   const double* WorldToNDC = nullptr;
   bool First = true;
   int Layers = 0;
 
   /// Composite a layer (rgb, alpha) found at ray parameter t; the first
-  /// layer of at least minimumAlpha gives the pixel its depth, normal and source.
-  void Record(const vtkVolumeCutRay& ray, double t, int source, const double normal[3], const float rgb[3], float alpha, float minimumAlpha)
+  /// layer of at least minimumAlpha gives the pixel its depth, normal, source and segment.
+  void Record(const vtkVolumeCutRay& ray, double t, int source, int segment, const double normal[3], const float rgb[3], float alpha,
+    float minimumAlpha)
   {
     const float remaining = 1.f - this->Color[3];
     for (int c = 0; c < 3; ++c)
@@ -52,6 +54,7 @@ struct vtkVolumeCutRayResult
         this->Normal[axis] = static_cast<float>(normal[axis]);
       }
       *this->Source = source;
+      *this->Segment = segment;
     }
   }
 

@@ -86,12 +86,16 @@ public:
     return static_cast<float>(c0 + f[2] * (c1 - c0));
   }
 
-  /// The segment label with the largest trilinear weight among the cell's
-  /// corners (hidden segments included, background not), and that weight (the
-  /// label's interpolated indicator). Where two segments meet, their border is
-  /// where their weights are equal, a smooth surface; where a segment meets
-  /// the background, the CT's iso-surface (or the indicator at 0.5) decides.
-  int DominantLabel(const double p[3], double& weight) const
+  /**
+   * The segment of greatest weight at p, and that weight: each label's
+   * trilinear weight among the corners of p's cell that \a acceptCorner(label,
+   * voxel, weight) takes, replaced by the interpolated fraction for segments
+   * with a fractional labelmap that \a acceptFraction(label) takes (the label
+   * map's indicator is the binary special case of a fraction). Ties go to
+   * the lower label so that every path decides the same way; 0 when none.
+   */
+  template <typename CornerFilter, typename FractionFilter>
+  int StrongestLabel(const double p[3], CornerFilter&& acceptCorner, FractionFilter&& acceptFraction, double& weight) const
   {
     const vtkVolumeCutRayScene& scene = this->Scene;
     int base[3];
@@ -100,7 +104,6 @@ public:
     int labels[8 + vtkVolumeCutRayScene::MaximumFractions];
     double weights[8 + vtkVolumeCutRayScene::MaximumFractions];
     int count = 0;
-    double unlabelledBright = 0.0;
     for (int corner = 0; corner < 8 && !scene.Labels.empty(); ++corner)
     {
       const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
@@ -108,15 +111,8 @@ public:
       const int label = scene.Labels[voxel];
       const double w =
         ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
-      if (label == 0)
+      if (!acceptCorner(label, voxel, w))
       {
-        // Material above the surface value that no shown segment claims
-        // competes like a segment: its border with a shown one is smooth,
-        // not the cell faces where a labelled voxel first counts.
-        if (scene.AnyIsoSegment && scene.Values[voxel] >= scene.MinimumIso)
-        {
-          unlabelledBright += w;
-        }
         continue;
       }
       int slot = 0;
@@ -131,10 +127,12 @@ public:
       }
       weights[slot] += w;
     }
-    // A segment with a fractional labelmap weighs its interpolated fraction
-    // (the label map's indicator is its binary special case).
     for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
     {
+      if (!acceptFraction(fraction.Label))
+      {
+        continue;
+      }
       const double w = this->InterpolateArray(fraction.Values.data(), p);
       int slot = 0;
       while (slot < count && labels[slot] != fraction.Label)
@@ -151,18 +149,70 @@ public:
     weight = 0.0;
     for (int slot = 0; slot < count; ++slot)
     {
-      // Ties go to the lower label so that every path decides the same way.
       if (weights[slot] > weight || (weights[slot] == weight && weight > 0.0 && labels[slot] < best))
       {
         best = labels[slot];
         weight = weights[slot];
       }
     }
-    if (unlabelledBright > weight)
-    {
-      return 0;
-    }
     return best;
+  }
+
+  /// The segment label with the largest trilinear weight among the cell's
+  /// corners (hidden segments included, background not), and that weight (the
+  /// label's interpolated indicator). Where two segments meet, their border is
+  /// where their weights are equal, a smooth surface; where a segment meets
+  /// the background, the CT's iso-surface (or the indicator at 0.5) decides.
+  int DominantLabel(const double p[3], double& weight) const
+  {
+    const vtkVolumeCutRayScene& scene = this->Scene;
+    double unlabelledBright = 0.0;
+    const int best = this->StrongestLabel(
+      p,
+      [&](int label, vtkIdType voxel, double w) {
+        if (label == 0)
+        {
+          // Material above the surface value that no shown segment claims
+          // competes like a segment: its border with a shown one is smooth,
+          // not the cell faces where a labelled voxel first counts.
+          if (scene.AnyIsoSegment && scene.Values[voxel] >= scene.MinimumIso)
+          {
+            unlabelledBright += w;
+          }
+          return false;
+        }
+        return true;
+      },
+      [](int) { return true; }, weight);
+    return unlabelledBright > weight ? 0 : best;
+  }
+
+  /// Whether a label is a shown segment whose surface is a CT iso-surface.
+  bool ShownIsoSegment(int label) const
+  {
+    const std::vector<vtkVolumeCutRayScene::SegmentStyle>& styles = this->Scene.Styles;
+    return label > 0 && label < static_cast<int>(styles.size()) && styles[label].Opacity > 0.f && !styles[label].Shape;
+  }
+
+  /**
+   * The segment whose material lies under a point p (IJK) of an iso-surface:
+   * among the corners of p's cell inside the surface (CT value at or above
+   * their segment's iso-value), the shown, iso-defined segment of greatest
+   * weight (fractional labelmaps weigh their fraction); 0 if there is none.
+   * The voxels an iso-surface crosses hold part bone, part surroundings:
+   * those outside it often carry another label (or none) than the bone
+   * behind, whose colour the surface should show.
+   */
+  int MaterialOwner(const double p[3]) const
+  {
+    const vtkVolumeCutRayScene& scene = this->Scene;
+    double weight = 0.0;
+    return this->StrongestLabel(
+      p,
+      [&](int label, vtkIdType voxel, double) {
+        return this->ShownIsoSegment(label) && scene.Values[voxel] >= scene.Styles[label].Iso;
+      },
+      [&](int label) { return this->ShownIsoSegment(label); }, weight);
   }
 
   /// Interpolated indicator of one label (for shape-defined segments' normals).

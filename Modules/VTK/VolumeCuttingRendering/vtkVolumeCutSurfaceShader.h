@@ -7,7 +7,8 @@
  *
  * A visible piece is shaded with the normal of the field whose border starts
  * it: the CT's gray-level gradient (central differences GradientStep voxels
- * apart) or the segment's own indicator on object surfaces, the cut field's
+ * apart) or the segment's own indicator on object surfaces, coloured as the
+ * segment whose material lies under the surface (MaterialOwner), the cut field's
  * gradient on cut surfaces, the plane's or box face's normal on clip
  * surfaces; Phong lighting with a headlight, then thin-bone shading
  * (vtkVolumeCutThinBoneShader) where it is on.
@@ -123,9 +124,16 @@ public:
     {
       index[axis] = ray.Origin[axis] + t * ray.Direction[axis];
     }
+    int owner = piece.Object;
     if (source == vtkVolumeCutRayCaster::SourceObject)
     {
       this->ObjectNormal(piece.Object, index, normal);
+      // Coloured as the material under it, not as the voxels it crosses.
+      if (this->Scene.HasSegments() && !this->Scene.Styles[piece.Object].Shape)
+      {
+        const int material = this->Classifier.MaterialOwner(index);
+        owner = material > 0 ? material : owner;
+      }
     }
     else if (source >= vtkVolumeCutRayCaster::SourceCutField)
     {
@@ -144,7 +152,7 @@ public:
         normal[axis] = -normal[axis];
       }
     }
-    const vtkVolumeCutRayScene::SegmentStyle& style = this->Scene.Styles[piece.Object];
+    const vtkVolumeCutRayScene::SegmentStyle& style = this->Scene.Styles[owner];
     float rgb[3];
     this->Shade(style.Color, normal, ray.View, rgb);
     float alpha = style.Opacity;
@@ -152,7 +160,7 @@ public:
     {
       this->ThinBone.Apply(index, normal, rgb, alpha);
     }
-    result.Record(ray, t, source, normal, rgb, alpha, 0.f);
+    result.Record(ray, t, source, owner, normal, rgb, alpha, 0.f);
     return result.Opaque() || ++result.Layers >= vtkVolumeCutRayResult::MaximumLayers;
   }
 

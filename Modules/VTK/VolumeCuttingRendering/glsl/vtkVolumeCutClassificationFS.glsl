@@ -68,7 +68,16 @@ vec4 fractionsAt(vec3 p)
   return value;
 }
 
-int dominantLabel(vec3 p, out float weight)
+bool shownIsoSegment(int label)
+{
+  return label > 0 && label < styleCount && styleColor(label).a > 0.0 && styleSurface(label).y <= 0.5;
+}
+
+// The segment of greatest weight at p (vtkVolumeCutSampleClassifier::
+// StrongestLabel). materialOnly: only the corners of shown iso-defined
+// segments inside their surface count (MaterialOwner); otherwise every
+// labelled corner, and unlabelled bright material competes (DominantLabel).
+int strongestLabel(vec3 p, bool materialOnly, out float weight)
 {
   ivec3 b;
   vec3 f;
@@ -81,7 +90,14 @@ int dominantLabel(vec3 p, out float weight)
   {
     int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
     float w = cornerWeight(corner, f);
-    if (label == 0)
+    if (materialOnly)
+    {
+      if (!shownIsoSegment(label) || texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r < styleSurface(label).x)
+      {
+        continue;
+      }
+    }
+    else if (label == 0)
     {
       if (anyIso != 0 && texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r >= minimumIso)
       {
@@ -108,6 +124,10 @@ int dominantLabel(vec3 p, out float weight)
     for (int i = 0; i < fractionCount; ++i)
     {
       int label = int(fractionLabels[i] + 0.5);
+      if (materialOnly && !shownIsoSegment(label))
+      {
+        continue;
+      }
       int slot = 0;
       while (slot < count && labels[slot] != label)
       {
@@ -131,11 +151,20 @@ int dominantLabel(vec3 p, out float weight)
       weight = weights[slot];
     }
   }
-  if (unlabelledBright > weight)
+  if (!materialOnly && unlabelledBright > weight)
   {
     return 0;
   }
   return best;
+}
+
+int dominantLabel(vec3 p, out float weight) { return strongestLabel(p, false, weight); }
+
+// The segment whose material lies under an iso-surface point (0 for none).
+int materialOwner(vec3 p)
+{
+  float weight;
+  return strongestLabel(p, true, weight);
 }
 
 float indicator(int label, vec3 p)

@@ -65,9 +65,16 @@ bool enter(Sample piece, float t, int source)
 {
   vec3 index = rayOrigin + t * rayDirection;
   vec3 normal;
+  int owner = piece.object;
   if (source == SOURCE_OBJECT)
   {
     normal = objectNormal(piece.object, index);
+    // Coloured as the material under it, not as the voxels it crosses.
+    if (hasLabels != 0 && styleSurface(piece.object).y <= 0.5)
+    {
+      int material = materialOwner(index);
+      owner = material > 0 ? material : owner;
+    }
   }
   else if (source >= SOURCE_CUT)
   {
@@ -81,7 +88,7 @@ bool enter(Sample piece, float t, int source)
   {
     normal = -normal;
   }
-  vec4 style = styleColor(piece.object);
+  vec4 style = styleColor(owner);
   vec3 rgb = shade(style.rgb, normal, viewVector);
   float alpha = style.a;
   if (thinBone != 0)

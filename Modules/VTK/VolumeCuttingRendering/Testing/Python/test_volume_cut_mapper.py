@@ -559,3 +559,63 @@ def test_a_lost_context_is_rebuilt_without_a_crash(scene, intensities, path):
     assert mapper.GetLastRenderPath() == getattr(vc.vtkVolumeCutVolumeMapper, path)
     assert np.any(before < 1.0)
     assert np.allclose(before, after, atol=1e-6)
+
+
+def partial_volume_ball(n=40, center=(19.6, 20.3, 19.8), radius=11.0, ramp=2.5):
+    """A bone ball as CT sees it (1500 HU, a linear ramp to -1000 HU over ``ramp`` voxels
+    outside ``radius``) and labels: 1 where the CT is at or above 300 HU, 2 on the ramp's
+    outer voxels (a halo of another segment around the bone, as segmentations have)."""
+    index = np.arange(n, dtype=float)
+    z, y, x = np.meshgrid(index - center[2], index - center[1], index - center[0], indexing="ij")
+    r = np.sqrt(x * x + y * y + z * z)
+    ct = np.clip(1500.0 - 2500.0 * (r - radius) / ramp, -1000.0, 1500.0).astype(np.float32)
+    labels = np.zeros(ct.shape, np.uint16)
+    labels[ct >= 300.0] = 1
+    labels[(ct < 300.0) & (ct > -900.0)] = 2
+
+    def image(values):
+        result = vtk.vtkImageData()
+        result.SetDimensions(n, n, n)
+        result.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.ravel(), deep=True))
+        return result
+
+    return image(ct), image(labels)
+
+
+def test_surface_shows_the_segment_of_the_material_behind_it():
+    """The 300 HU surface crosses voxels of the halo segment; it is coloured as the bone under it."""
+    ct, labels = partial_volume_ball()
+    width = 64
+    window, renderer = render_window(width)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(20.0, 20.0, 20.0)
+    camera.SetPosition(20.0, -60.0, 35.0)
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    renderer.SetActiveCamera(camera)
+    renderer.ResetCameraClippingRange()
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(ct)
+    caster = mapper.GetRayCaster()
+    caster.SetLabelMap(labels)
+    caster.SetSegmentAppearance(1, (0.9, 0.2, 0.2), 1.0, 300.0)
+    caster.SetSegmentAppearance(2, (0.2, 0.9, 0.2), 1.0, 300.0)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    renderer.AddVolume(volume)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    owners = image_array(caster.GetSegmentImage, width, width, 1)
+    surface = owners > 0
+    assert surface.sum() > 0.15 * width * width
+    assert np.all(owners[surface] == 1)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    covered = cpu_depth < 1.0
+    assert np.all(cpu_color[covered][:, 0] > cpu_color[covered][:, 1])  # red bone, no green halo
+    assert np.array_equal(covered, gpu_depth < 1.0)
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
