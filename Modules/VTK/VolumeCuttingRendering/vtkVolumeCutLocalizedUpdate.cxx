@@ -13,9 +13,12 @@
 #include <cmath>
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(vtkVolumeCutField* field, vtkTypeUInt64 stamp, const double worldToNDC[16],
-  int width, int height, std::vector<uint8_t>& mask, int region[4])
+void vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(vtkVolumeCutField* field, vtkTypeUInt64 stamp, double reach,
+  const double worldToNDC[16], int width, int height, std::vector<uint8_t>& mask, int region[4])
 {
+  double spacing[3];
+  field->GetSubVoxelSpacing(spacing);
+  const double margin = std::ceil(reach / std::min({ spacing[0], spacing[1], spacing[2] }));
   vtkNew<vtkIdList> bricks;
   field->GetBricksModifiedSince(stamp, bricks);
   const int* brickDims = field->GetBrickDimensions();
@@ -27,14 +30,14 @@ void vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(vtkVolumeCutField* field, v
     const int b[3] = { static_cast<int>(id % brickDims[0]), static_cast<int>((id / brickDims[0]) % brickDims[1]),
       static_cast<int>(id / (static_cast<vtkIdType>(brickDims[0]) * brickDims[1])) };
     // A brick's samples reach two sub-voxels beyond it (interpolation and
-    // its curvature correction).
+    // its curvature correction), and shading reaches margin beyond that.
     double lo[2] = { 1e300, 1e300 };
     double hi[2] = { -1e300, -1e300 };
     bool behind = false;
     for (int corner = 0; corner < 8; ++corner)
     {
-      double sub[4] = { b[0] * 8.0 + ((corner & 1) ? 10.0 : -3.0), b[1] * 8.0 + ((corner & 2) ? 10.0 : -3.0),
-        b[2] * 8.0 + ((corner & 4) ? 10.0 : -3.0), 1.0 };
+      double sub[4] = { b[0] * 8.0 + ((corner & 1) ? 10.0 + margin : -3.0 - margin),
+        b[1] * 8.0 + ((corner & 2) ? 10.0 + margin : -3.0 - margin), b[2] * 8.0 + ((corner & 4) ? 10.0 + margin : -3.0 - margin), 1.0 };
       double world[4];
       subToWorld->MultiplyPoint(sub, world);
       double clip[4];

@@ -25,12 +25,13 @@ class vtkVolumeCutLocalizedUpdate
 public:
   /**
    * Set to 1 the pixels of \a mask (width x height, row 0 at the bottom)
-   * whose rays may meet a brick of \a field modified since \a stamp, seen
-   * through \a worldToNDC (row-major), and grow \a region (x0, y0, x1, y1,
-   * inclusive) to hold them.
+   * whose rays may meet a brick of \a field modified since \a stamp, or
+   * whose shading looks up to \a reach (mm) from their surface into one
+   * (ambient occlusion, thin bone), seen through \a worldToNDC (row-major),
+   * and grow \a region (x0, y0, x1, y1, inclusive) to hold them.
    */
-  static void MarkModifiedBricks(vtkVolumeCutField* field, vtkTypeUInt64 stamp, const double worldToNDC[16], int width, int height,
-    std::vector<uint8_t>& mask, int region[4]);
+  static void MarkModifiedBricks(vtkVolumeCutField* field, vtkTypeUInt64 stamp, double reach, const double worldToNDC[16], int width,
+    int height, std::vector<uint8_t>& mask, int region[4]);
 };
 
 #endif

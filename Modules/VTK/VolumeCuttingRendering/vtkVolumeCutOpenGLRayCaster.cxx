@@ -363,14 +363,15 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   }
   if (impl.SceneVersion != view.Version)
   {
-    std::vector<float> styles(8 * view.Styles.size());
+    std::vector<float> styles(12 * view.Styles.size());
     const int styleCount = static_cast<int>(view.Styles.size());
     for (int label = 0; label < styleCount; ++label)
     {
       std::copy(view.Styles[label].begin(), view.Styles[label].begin() + 4, styles.begin() + 4 * label);
-      std::copy(view.Styles[label].begin() + 4, view.Styles[label].end(), styles.begin() + 4 * (styleCount + label));
+      std::copy(view.Styles[label].begin() + 4, view.Styles[label].begin() + 8, styles.begin() + 4 * (styleCount + label));
+      std::copy(view.Styles[label].begin() + 8, view.Styles[label].end(), styles.begin() + 4 * (2 * styleCount + label));
     }
-    impl.Styles = Internals::Texture2D(window, styleCount, 2, 4, styles.data());
+    impl.Styles = Internals::Texture2D(window, styleCount, 3, 4, styles.data());
     const int* bd = view.BlockDimensions;
     const size_t blocks = static_cast<size_t>(bd[0]) * bd[1] * bd[2];
     std::vector<float> blockData(2 * blocks);
@@ -502,6 +503,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniformi("tableSize", std::max(view.TableSize, 2));
   program->SetUniformi("thinBone", s->GetThinBoneShading() ? 1 : 0);
   program->SetUniformf("thinBoneThickness", static_cast<float>(s->GetThinBoneThickness()));
+  program->SetUniformi("ambientOcclusion", s->GetAmbientOcclusion() && s->GetBlendMode() == vtkVolumeCutRayCaster::IsoSurfaceBlend ? 1 : 0);
+  program->SetUniformf("ambientOcclusionRadius", static_cast<float>(s->GetAmbientOcclusionRadius()));
   program->SetUniformi("refinements", view.MaximumRefinements);
   const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
   float planes[6][4] = {};

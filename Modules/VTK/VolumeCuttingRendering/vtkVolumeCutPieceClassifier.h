@@ -65,6 +65,17 @@ public:
       b = from;
       return false;
     }
+    // A border exactly at the previous sample leaves a piece of no length
+    // whose middle is classified as what lies before it: the visible
+    // material that starts at a is entered here, not missed.
+    if (!insideVisible && this->Classifier.Visible(a))
+    {
+      if (this->Shader.Enter(ray, a, a.T, vtkVolumeCutRayCaster::SourceObject, result))
+      {
+        return true;
+      }
+      insideVisible = true;
+    }
     vtkVolumeCutBorder borders[vtkVolumeCutRayScene::MaximumCutFields + 1];
     const int count = this->Locator.FindBorders(ray, a, b, true, borders);
     for (int border = 0; border < count; ++border)

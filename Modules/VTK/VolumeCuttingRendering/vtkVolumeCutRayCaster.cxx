@@ -8,6 +8,7 @@
 #include "vtkVolumeCutCompositor.h"
 #include "vtkVolumeCutEmptySpace.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutLabelSmoothing.h"
 #include "vtkVolumeCutLocalizedUpdate.h"
 #include "vtkVolumeCutParallelFor.h"
 #include "vtkVolumeCutPieceClassifier.h"
@@ -80,6 +81,11 @@ struct vtkVolumeCutRayCaster::Internals
   };
   std::map<int, FractionInput> FractionInputs;
   vtkMTimeType FractionCopyTime = 0;
+  size_t CopiedFractionInputs = 0;
+  size_t GivenFractions = 0; // Scene.Fractions: the given ones first, then the smoothed ones
+  std::vector<int> SmoothedLabels;
+  double SmoothedSigma = 0.0;
+  vtkMTimeType SmoothedLabelVersion = 0;
   std::vector<CutEntry> Cuts;
   std::vector<int> ActiveCuts; // indices into Cuts of the scene's cut fields
   vtkSmartPointer<vtkPlaneCollection> Planes;
@@ -342,11 +348,28 @@ void vtkVolumeCutRayCaster::SetSegmentAppearance(int label, const double color[3
   for (int c = 0; c < 3; ++c)
   {
     style.Color[c] = static_cast<float>(std::min(1.0, std::max(0.0, color[c])));
+    style.SurfaceColor[c] = style.Color[c];
   }
   style.Opacity = std::isfinite(opacity) ? static_cast<float>(std::min(1.0, std::max(0.0, opacity))) : 0.f;
   style.Shape = std::isnan(isoValue);
   style.Iso = style.Shape ? 0.f : static_cast<float>(isoValue);
   style.Defined = true;
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutRayCaster::SetSegmentSurfaceColor(int label, const double color[3])
+{
+  if (label < 1 || label >= static_cast<int>(this->Impl->Scene.Styles.size()) || !this->Impl->Scene.Styles[label].Defined || !color)
+  {
+    vtkErrorMacro("SetSegmentSurfaceColor: segment " << label << " has no appearance; call SetSegmentAppearance first");
+    return;
+  }
+  SegmentStyle& style = this->Impl->Scene.Styles[label];
+  for (int c = 0; c < 3; ++c)
+  {
+    style.SurfaceColor[c] = static_cast<float>(std::min(1.0, std::max(0.0, color[c])));
+  }
   this->Modified();
 }
 
@@ -625,9 +648,11 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     fractionTime = std::max({ fractionTime, image->GetMTime(),
       image->GetPointData()->GetScalars() ? image->GetPointData()->GetScalars()->GetMTime() : vtkMTimeType(0) });
   }
-  if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.Scene.Fractions.size() || sceneChanged)
+  if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.CopiedFractionInputs || sceneChanged)
   {
     impl.Scene.Fractions.clear();
+    impl.SmoothedLabels.clear();
+    impl.CopiedFractionInputs = impl.FractionInputs.size();
     for (const auto& entry : impl.FractionInputs)
     {
       vtkImageData* image = entry.second.Image;
@@ -649,6 +674,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       }
       impl.Scene.Fractions.push_back(std::move(fraction));
     }
+    impl.GivenFractions = impl.Scene.Fractions.size();
     impl.FractionCopyTime = std::max(fractionTime, vtkMTimeType(1));
     ++impl.LabelVersion;
     impl.BlockTime = 0;
@@ -659,9 +685,9 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   if (impl.DefaultStyles)
   {
     SegmentStyle& bone = impl.Scene.Styles[1];
-    bone.Color[0] = 0.95f;
-    bone.Color[1] = 0.92f;
-    bone.Color[2] = 0.84f;
+    bone.Color[0] = bone.SurfaceColor[0] = 0.95f;
+    bone.Color[1] = bone.SurfaceColor[1] = 0.92f;
+    bone.Color[2] = bone.SurfaceColor[2] = 0.84f;
     bone.Opacity = 1.f;
     bone.Iso = static_cast<float>(this->IsoValue);
     bone.Shape = false;
@@ -669,6 +695,41 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   if (impl.Scene.Styles.size() < 2)
   {
     impl.Scene.Styles.resize(2);
+  }
+
+  // Segments drawn by their shape from the label map alone: fractions from
+  // their smoothed indicator, after the given ones, made again when the
+  // labels, those segments or the smoothing change.
+  std::vector<int> smoothed;
+  if (this->LabelSmoothing > 0.0 && !impl.Scene.Labels.empty())
+  {
+    for (size_t label = 1; label < impl.Scene.Styles.size(); ++label)
+    {
+      const SegmentStyle& style = impl.Scene.Styles[label];
+      if (style.Defined && style.Shape && style.Opacity > 0.f && !impl.FractionInputs.count(static_cast<int>(label)) &&
+        impl.FractionInputs.size() + smoothed.size() < static_cast<size_t>(MaximumFractions))
+      {
+        smoothed.push_back(static_cast<int>(label));
+      }
+    }
+  }
+  if (smoothed != impl.SmoothedLabels || (!smoothed.empty() && (impl.SmoothedSigma != this->LabelSmoothing || impl.SmoothedLabelVersion != impl.LabelVersion)))
+  {
+    impl.Scene.Fractions.resize(impl.GivenFractions);
+    double spacing[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double column[3] = { impl.Scene.IJKToWorld[axis], impl.Scene.IJKToWorld[4 + axis], impl.Scene.IJKToWorld[8 + axis] };
+      spacing[axis] = vtkMath::Norm(column);
+    }
+    vtkVolumeCutLabelSmoothing::Smooth(impl.Scene.Labels, impl.Scene.Dimensions, spacing, smoothed, this->LabelSmoothing,
+      this->MaximumNumberOfThreads, impl.Scene.Fractions);
+    impl.SmoothedLabels = smoothed;
+    impl.SmoothedSigma = this->LabelSmoothing;
+    ++impl.LabelVersion;
+    impl.SmoothedLabelVersion = impl.LabelVersion;
+    impl.BlockTime = 0;
+    sceneChanged = true;
   }
 
   // Transfer functions (composite mode).
@@ -727,6 +788,8 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   impl.Scene.UnitDistance = this->ScalarOpacityUnitDistance;
   impl.Scene.ThinBone = this->ThinBoneShading;
   impl.Scene.ThinBoneThickness = this->ThinBoneThickness;
+  impl.Scene.AmbientOcclusion = this->AmbientOcclusion && this->BlendMode == IsoSurfaceBlend;
+  impl.Scene.AmbientOcclusionRadius = this->AmbientOcclusionRadius;
   impl.Scene.Ambient = this->Ambient;
   impl.Scene.Diffuse = this->Diffuse;
   impl.Scene.Specular = this->Specular;
@@ -854,7 +917,8 @@ bool vtkVolumeCutRayCaster::UpdateScene(SceneView& view)
   view.Styles.clear();
   for (const SegmentStyle& style : impl.Scene.Styles)
   {
-    view.Styles.push_back({ style.Color[0], style.Color[1], style.Color[2], style.Opacity, style.Iso, style.Shape ? 1.f : 0.f, 0.f, 0.f });
+    view.Styles.push_back({ style.Color[0], style.Color[1], style.Color[2], style.Opacity, style.Iso, style.Shape ? 1.f : 0.f, 0.f, 0.f,
+      style.SurfaceColor[0], style.SurfaceColor[1], style.SurfaceColor[2], 0.f });
   }
   std::copy(impl.Scene.EmptySpace.GetDimensions(), impl.Scene.EmptySpace.GetDimensions() + 3, view.BlockDimensions);
   view.BlockOccupied = impl.Scene.EmptySpace.GetOccupied();
@@ -946,7 +1010,10 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     for (int index : impl.ActiveCuts)
     {
       const CutEntry& entry = impl.Cuts[index];
-      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(entry.Field, entry.RenderedStamp, matrix, width, height, mask, this->UpdatedRegion);
+      const double reach = std::max(impl.Scene.AmbientOcclusion ? impl.Scene.AmbientOcclusionRadius : 0.0,
+        impl.Scene.ThinBone ? impl.Scene.ThinBoneThickness : 0.0);
+      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(
+        entry.Field, entry.RenderedStamp, reach, matrix, width, height, mask, this->UpdatedRegion);
     }
   }
   for (size_t n = 0; n < impl.Cuts.size(); ++n)

@@ -29,7 +29,8 @@ struct vtkVolumeCutRayScene
   /// How a segment looks and where its surface is.
   struct SegmentStyle
   {
-    float Color[3] = { 1.f, 1.f, 1.f };
+    float Color[3] = { 1.f, 1.f, 1.f };        // of cut and clip surfaces
+    float SurfaceColor[3] = { 1.f, 1.f, 1.f }; // of the segment's own (uncut) surface
     float Opacity = 0.f;
     float Iso = 0.f;
     bool Shape = false; // the surface is the label's own indicator at 0.5
@@ -86,6 +87,8 @@ struct vtkVolumeCutRayScene
   double UnitDistance = 1.0;
   bool ThinBone = false;
   double ThinBoneThickness = 1.0;
+  bool AmbientOcclusion = false;
+  double AmbientOcclusionRadius = 4.0;
   double Ambient = 0.25, Diffuse = 0.7, Specular = 0.2, SpecularPower = 20.0;
 };
 

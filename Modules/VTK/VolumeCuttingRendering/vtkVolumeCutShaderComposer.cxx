@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutShaderComposer.h"
 
+#include "vtkVolumeCutAmbientOcclusionFS.h"
 #include "vtkVolumeCutBorderLocationFS.h"
 #include "vtkVolumeCutClassificationFS.h"
 #include "vtkVolumeCutCompositeFS.h"
@@ -29,6 +30,7 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::EmptySpace::Dec", vtkVolumeCutEmptySpaceFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::BorderLocation::Dec", vtkVolumeCutBorderLocationFS);
+  vtkShaderProgram::Substitute(source, "//VolumeCut::AmbientOcclusion::Dec", vtkVolumeCutAmbientOcclusionFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::ThinBone::Dec", vtkVolumeCutThinBoneFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::Shading::Dec", vtkVolumeCutShadingFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::PieceClassification::Dec", vtkVolumeCutPieceClassificationFS);

@@ -10,14 +10,16 @@
  * apart) or the segment's own indicator on object surfaces, coloured as the
  * segment whose material lies under the surface (MaterialOwner), the cut field's
  * gradient on cut surfaces, the plane's or box face's normal on clip
- * surfaces; Phong lighting with a headlight, then thin-bone shading
- * (vtkVolumeCutThinBoneShader) where it is on.
+ * surfaces; Phong lighting with a headlight, ambient occlusion
+ * (vtkVolumeCutAmbientOcclusion) and thin-bone shading
+ * (vtkVolumeCutThinBoneShader) where they are on.
  *
  * @sa vtkVolumeCutPieceClassifier (step 3)
  */
 #ifndef vtkVolumeCutSurfaceShader_h
 #define vtkVolumeCutSurfaceShader_h
 
+#include "vtkVolumeCutAmbientOcclusion.h"
 #include "vtkVolumeCutRayResult.h"
 #include "vtkVolumeCutThinBoneShader.h"
 
@@ -32,6 +34,7 @@ public:
     : Scene(scene)
     , Classifier(classifier)
     , ThinBone(scene, classifier)
+    , Occlusion(scene, classifier)
   {
   }
 
@@ -154,8 +157,12 @@ public:
     }
     const vtkVolumeCutRayScene::SegmentStyle& style = this->Scene.Styles[owner];
     float rgb[3];
-    this->Shade(style.Color, normal, ray.View, rgb);
+    this->Shade(source == vtkVolumeCutRayCaster::SourceObject ? style.SurfaceColor : style.Color, normal, ray.View, rgb);
     float alpha = style.Opacity;
+    if (this->Scene.AmbientOcclusion)
+    {
+      this->Occlusion.Apply(index, normal, rgb);
+    }
     if (this->Scene.ThinBone)
     {
       this->ThinBone.Apply(index, normal, rgb, alpha);
@@ -168,6 +175,7 @@ private:
   const vtkVolumeCutRayScene& Scene;
   const vtkVolumeCutSampleClassifier& Classifier;
   vtkVolumeCutThinBoneShader ThinBone;
+  vtkVolumeCutAmbientOcclusion Occlusion;
 };
 
 #endif

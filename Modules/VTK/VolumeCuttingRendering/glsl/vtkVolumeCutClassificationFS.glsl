@@ -6,7 +6,7 @@
 
 uniform sampler3D anatomyTexture;   // CT (R32F), fetched texel by texel
 uniform sampler3D labelTexture;     // labels (R32F), when hasLabels
-uniform sampler2D styleTexture;     // per label: (rgb, opacity), (iso, shape, 0, 0)
+uniform sampler2D styleTexture;     // per label: (rgb, opacity), (iso, shape, 0, 0), (uncut surface rgb, 0)
 uniform int hasLabels;             // a label map or fractional labelmaps
 uniform int hasLabelMap;
 uniform sampler3D fractionTexture;  // up to 4 segments' fractions (RGBA)
@@ -47,6 +47,7 @@ float intensity(vec3 p)
 
 vec4 styleColor(int label) { return texelFetch(styleTexture, ivec2(label, 0), 0); }
 vec4 styleSurface(int label) { return texelFetch(styleTexture, ivec2(label, 1), 0); }
+vec3 styleSurfaceColor(int label) { return texelFetch(styleTexture, ivec2(label, 2), 0).rgb; }
 
 float cornerWeight(int corner, vec3 f)
 {

@@ -10,6 +10,15 @@ uniform int refinements;
 // The borders between two samples and the first visible piece between them.
 bool leafInterval(inout Sample a, inout Sample b)
 {
+  // A border exactly at the previous sample: enter the material that starts at a.
+  if (!insideVisible && visible(a))
+  {
+    if (enter(a, a.t, SOURCE_OBJECT))
+    {
+      return true;
+    }
+    insideVisible = true;
+  }
   float borderT[CUT_SLOTS + 1];
   int borderSource[CUT_SLOTS + 1];
   int count = 0;

@@ -62,7 +62,8 @@ bool insideVisible = false;
 //VolumeCut::EmptySpace::Dec
 // ---- step 2: border location
 //VolumeCut::BorderLocation::Dec
-// ---- step 4: shading (with thin bone)
+// ---- step 4: shading (with ambient occlusion and thin bone)
+//VolumeCut::AmbientOcclusion::Dec
 //VolumeCut::ThinBone::Dec
 //VolumeCut::Shading::Dec
 // ---- step 3: classification of pieces between borders

@@ -89,8 +89,12 @@ bool enter(Sample piece, float t, int source)
     normal = -normal;
   }
   vec4 style = styleColor(owner);
-  vec3 rgb = shade(style.rgb, normal, viewVector);
+  vec3 rgb = shade(source == SOURCE_OBJECT ? styleSurfaceColor(owner) : style.rgb, normal, viewVector);
   float alpha = style.a;
+  if (ambientOcclusion != 0)
+  {
+    rgb *= 1.0 - 0.75 * occlusion(index, normal);
+  }
   if (thinBone != 0)
   {
     applyThinBone(piece.object, index, normal, rgb, alpha);

@@ -619,3 +619,176 @@ def test_surface_shows_the_segment_of_the_material_behind_it():
     assert np.array_equal(covered, gpu_depth < 1.0)
     assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
     assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+
+
+def shell_and_core(scene):
+    """Labels of the cube: a 3-voxel shell (segment 1, cortex) around a core (segment 2, cancellous bone)."""
+    n = scene.dimensions
+    index = np.arange(n) - (n - 1) / 2.0
+    depth = scene.half_size_voxels - np.max(np.abs(np.stack(np.meshgrid(index, index, index, indexing="ij"))), axis=0)
+    labels = np.where(depth >= 3.0, 2, 1).astype(np.uint16)
+    image = vtk.vtkImageData()
+    image.SetDimensions(n, n, n)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(labels.ravel(), deep=True))
+    return image
+
+
+def test_segments_of_one_material_share_their_surface_colour_and_cuts_tell_them_apart(scene, intensities):
+    width = 64
+    cut = vc.vtkVolumeCutField()
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    top = scene.center + [0.0, 0.0, scene.half_size]
+    cut.CutCapsule(list(top), list(top), 5.0)  # a pit through the shell into the core
+    window, renderer = render_window(width)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*scene.center)
+    camera.SetPosition(*(scene.center + [25.0, -30.0, 60.0]))
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    renderer.SetActiveCamera(camera)
+    renderer.ResetCameraClippingRange()
+    mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
+    caster = mapper.GetRayCaster()
+    caster.SetLabelMap(shell_and_core(scene))
+    cortex, cancellous = (0.9, 0.9, 0.8), (0.8, 0.3, 0.2)
+    caster.SetSegmentAppearance(1, cortex, 1.0, scene.iso_value())
+    caster.SetSegmentAppearance(2, cancellous, 1.0, scene.iso_value())
+    caster.SetSegmentSurfaceColor(2, cortex)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    sources = image_array(caster.GetSourceImage, width, width, 1)
+    owners = image_array(caster.GetSegmentImage, width, width, 1)
+    rgba = image_array(caster.GetColorImage, width, width, 4)
+    outer = sources == vc.vtkVolumeCutRayCaster.SourceObject
+    exposed = sources == vc.vtkVolumeCutRayCaster.SourceCutField
+    assert outer.sum() > 500 and exposed.sum() > 50
+    # Uncut: one bone, whichever segment owns it; cut: each its own colour.
+    redness = rgba[..., 0] / np.maximum(rgba[..., 2], 1e-6)  # 1.1 for the cortex's colour, 4 for the core's
+    assert np.all(redness[outer] < 1.5)
+    assert np.any(exposed & (owners == 1)) and np.any(exposed & (owners == 2))
+    assert np.all(redness[exposed & (owners == 2)] > 2.0)
+    assert np.all(redness[exposed & (owners == 1)] < 1.5)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    # (a ray grazing the cube's far edge may end on either side of it)
+    assert np.mean(np.abs(cpu_depth - gpu_depth) > 1e-4) < 0.005
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+    log = ErrorLog(caster)
+    caster.SetSegmentSurfaceColor(9, cortex)  # no such segment
+    assert "has no appearance" in log.messages[-1]
+
+
+def test_ambient_occlusion_darkens_a_cavity_not_a_flat_face(scene, intensities):
+    width = 64
+    cut = vc.vtkVolumeCutField()
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    top = scene.center + [0.0, 0.0, scene.half_size]
+    cut.CutCapsule(list(top), list(top), 4.0)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*scene.center)
+    camera.SetPosition(*(scene.center + [0.0, 0.0, 100.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(50.0, 200.0)
+    matrix = A.world_to_ndc(camera, width, width)
+    images = {}
+    for occlusion in (False, True):
+        caster = vc.vtkVolumeCutRayCaster()
+        caster.SetAnatomy(intensities, scene.ijk_to_ras())
+        caster.SetIsoValue(scene.iso_value())
+        caster.AddCutField(cut)
+        caster.SetAmbientOcclusion(occlusion)
+        caster.SetAmbientOcclusionRadius(6.0)
+        assert caster.Render(matrix, width, width)
+        images[occlusion] = image_array(caster.GetColorImage, width, width, 4)
+    middle = width // 2
+    plain, occluded = images[False], images[True]
+    # The pit's floor is darker, the flat top away from the pit is not.
+    assert occluded[middle, middle, 0] < 0.8 * plain[middle, middle, 0]
+    assert occluded[middle + 20, middle + 20, 0] == pytest.approx(plain[middle + 20, middle + 20, 0], rel=1e-6)
+
+    # A stroke next to the pit: the localized update recasts the pixels whose
+    # occlusion looks into it, and equals a full render.
+    cut.CutCapsule(list(top + [8.0, 0.0, 0.0]), list(top + [8.5, 0.0, 0.0]), 1.0)
+    assert caster.Render(matrix, width, width)
+    assert caster.GetLastRenderWasLocalized()
+    fresh = vc.vtkVolumeCutRayCaster()
+    fresh.SetAnatomy(intensities, scene.ijk_to_ras())
+    fresh.SetIsoValue(scene.iso_value())
+    fresh.AddCutField(cut)
+    fresh.SetAmbientOcclusion(True)
+    fresh.SetAmbientOcclusionRadius(6.0)
+    assert fresh.Render(matrix, width, width)
+    assert np.array_equal(image_array(caster.GetColorImage, width, width, 4), image_array(fresh.GetColorImage, width, width, 4))
+
+
+def test_gpu_path_draws_ambient_occlusion_like_the_cpu(scene, intensities):
+    width = 48
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 1.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(2), renderer)
+    mapper.GetRayCaster().SetAmbientOcclusion(True)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+
+
+def test_binary_segments_are_smoothed_between_slices(scene, intensities):
+    """A ball stored as whole voxels on thick slices: smoothing brings its surface near the exact sphere, CPU and GPU alike."""
+    n, center, radius = 32, (15.3, 15.6, 15.2), 9.0
+    _, binary = sphere_segment(n, center, radius)
+    ct = vtk.vtkImageData()
+    ct.SetDimensions(n, n, n)
+    ct.AllocateScalars(vtk.VTK_FLOAT, 1)
+    ct.GetPointData().GetScalars().Fill(0.0)
+    ct.SetSpacing(0.7, 0.7, 2.5)
+    world_center = np.array(center) * [0.7, 0.7, 2.5]
+    ellipsoid_radii = radius * np.array([0.7, 0.7, 2.5])
+    camera = vtk.vtkCamera()
+    camera.ParallelProjectionOn()
+    camera.SetParallelScale(1.1 * ellipsoid_radii[2])
+    camera.SetFocalPoint(*world_center)
+    camera.SetPosition(*(world_center + [60.0, 0.0, 0.0]))
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    camera.SetClippingRange(20.0, 100.0)
+    width = 64
+    errors = {}
+    for smoothing in (0.0, 1.0):
+        window, renderer = render_window(width)
+        renderer.SetActiveCamera(camera)
+        mapper = vc.vtkVolumeCutVolumeMapper()
+        mapper.SetInputData(ct)
+        caster = mapper.GetRayCaster()
+        caster.SetLabelMap(binary)
+        caster.SetSegmentAppearance(1, (0.9, 0.8, 0.2), 1.0, float("nan"))
+        caster.SetLabelSmoothing(smoothing)
+        volume = vtk.vtkVolume()
+        volume.SetMapper(mapper)
+        renderer.AddVolume(volume)
+        images = {}
+        for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+            mapper.SetRequestedRenderPath(path)
+            window.Render()
+            assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+            images[path] = read_window(window, width)
+        cpu_depth, gpu_depth = images[vc.vtkVolumeCutVolumeMapper.CPUPath][0], images[vc.vtkVolumeCutVolumeMapper.GPUPath][0]
+        assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
+        assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+        matrix = A.world_to_ndc(camera, width, width)
+        points = A.depth_to_points(matrix, cpu_depth.astype(float))
+        # The ellipsoid the stretched ball is: its x at the rendered (y, z).
+        u = (points[..., 1] - world_center[1]) / ellipsoid_radii[1]
+        w = (points[..., 2] - world_center[2]) / ellipsoid_radii[2]
+        inner = (cpu_depth < 1.0) & (u * u + w * w < 0.6)
+        exact = world_center[0] + ellipsoid_radii[0] * np.sqrt(1.0 - u[inner] ** 2 - w[inner] ** 2)
+        errors[smoothing] = float(np.sqrt(np.mean((points[..., 0][inner] - exact) ** 2)))
+    assert errors[1.0] < 0.8 * errors[0.0]
