@@ -158,13 +158,13 @@ int vtkImageBoneSegmentation::RequestData(
   }
   if (this->BoundaryIsCortical)
   {
-    // The partial-volume shell, cortex by the paper's model: grown voxels
-    // with a face neighbour outside the bone, then, inwards, grown voxels on
-    // the rising ramp from such a voxel to the cortex (a face neighbour in
-    // the shell with a lower value, and a cortical one), as the shell is two
-    // voxels thick where the boundary falls near a voxel's edge. Each layer
-    // is found before it is relabelled, so that the shell does not spread
-    // further inwards.
+    // The partial-volume shell of the cortex, cortex by the paper's model:
+    // grown voxels on the ramp from the cortex (a cortical face neighbour)
+    // out to what is not bone. The shell is one or two voxels thick: its
+    // outer voxels touch the outside and the cortex, or a grown voxel of
+    // higher value that touches the cortex; its inner voxels touch the
+    // cortex and an outer voxel of lower value. Grown bone away from the
+    // cortex (septa between air cells) stays trabecular.
     auto faceNeighbors = [&](vtkIdType index, vtkIdType neighbors[6]) {
       const vtkIdType k = index / sliceSize;
       const vtkIdType j = (index - k * sliceSize) / dims[0];
@@ -176,54 +176,46 @@ int vtkImageBoneSegmentation::RequestData(
       neighbors[4] = k > 0 ? index - sliceSize : -1;
       neighbors[5] = k + 1 < dims[2] ? index + sliceSize : -1;
     };
+    auto touches = [&](vtkIdType index, auto&& predicate) {
+      vtkIdType neighbors[6];
+      faceNeighbors(index, neighbors);
+      return std::any_of(neighbors, neighbors + 6, [&](vtkIdType n) { return n >= 0 && predicate(n); });
+    };
     const size_t firstGrown = static_cast<size_t>(this->NumberOfCorticalVoxels);
-    std::vector<unsigned char> inShell(static_cast<size_t>(voxelCount), 0);
-    std::vector<vtkIdType> layer;
+    std::vector<unsigned char> state(static_cast<size_t>(voxelCount), 0); // 1: touches the cortex, 2: outer shell
     for (size_t head = firstGrown; head < queue.size(); ++head)
     {
-      vtkIdType neighbors[6];
-      faceNeighbors(queue[head], neighbors);
-      if (std::any_of(neighbors, neighbors + 6, [&](vtkIdType n) { return n >= 0 && labels[n] == BackgroundLabel; }))
-      {
-        layer.push_back(queue[head]);
-      }
+      state[queue[head]] = touches(queue[head], [&](vtkIdType n) { return labels[n] == CorticalLabel; }) ? 1 : 0;
     }
-    for (vtkIdType index : layer)
-    {
-      inShell[index] = 1;
-    }
-    std::vector<vtkIdType> ramp;
+    std::vector<vtkIdType> outer;
     for (size_t head = firstGrown; head < queue.size(); ++head)
     {
       const vtkIdType index = queue[head];
-      vtkIdType neighbors[6];
-      faceNeighbors(index, neighbors);
-      bool lowerShell = false;
-      bool cortex = false;
-      for (vtkIdType n : neighbors)
+      if (touches(index, [&](vtkIdType n) { return labels[n] == BackgroundLabel; }) &&
+        (state[index] == 1 || touches(index, [&](vtkIdType n) { return state[n] == 1 && values[n] > values[index]; })))
       {
-        lowerShell |= n >= 0 && inShell[n] && values[n] < values[index];
-        cortex |= n >= 0 && labels[n] == CorticalLabel;
-      }
-      if (!inShell[index] && lowerShell && cortex)
-      {
-        ramp.push_back(index);
+        outer.push_back(index);
       }
     }
-    for (vtkIdType index : ramp)
+    for (vtkIdType index : outer)
     {
-      inShell[index] = 1;
+      state[index] = 2;
     }
-    const vtkIdType relabelled = static_cast<vtkIdType>(layer.size() + ramp.size());
+    std::vector<vtkIdType> shell = outer;
     for (size_t head = firstGrown; head < queue.size(); ++head)
     {
-      if (inShell[queue[head]])
+      const vtkIdType index = queue[head];
+      if (state[index] == 1 && touches(index, [&](vtkIdType n) { return state[n] == 2 && values[n] < values[index]; }))
       {
-        labels[queue[head]] = CorticalLabel;
+        shell.push_back(index);
       }
     }
-    this->NumberOfCorticalVoxels += relabelled;
-    this->NumberOfTrabecularVoxels -= relabelled;
+    for (vtkIdType index : shell)
+    {
+      labels[index] = CorticalLabel;
+    }
+    this->NumberOfCorticalVoxels += static_cast<vtkIdType>(shell.size());
+    this->NumberOfTrabecularVoxels -= static_cast<vtkIdType>(shell.size());
   }
   this->UpdateProgress(1.0);
   return 1;

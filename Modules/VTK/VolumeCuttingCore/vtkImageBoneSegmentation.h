@@ -11,7 +11,7 @@
  *
  * Every voxel at or above CorticalThreshold seeds a region. Regions grow over
  * face-connected voxels at or above TrabecularThreshold. Grown voxels below
- * the cortical threshold are trabecular bone, except on the bone's boundary
+ * the cortical threshold are trabecular bone, except the cortex's boundary
  * (BoundaryIsCortical): the paper's bone model has a cortical boundary
  * around a trabecular interior, and where cortex meets air or soft tissue
  * the voxels the boundary passes through hold part cortex, part
@@ -65,9 +65,9 @@ public:
 
   ///@{
   /**
-   * Set/get whether grown voxels on the bone's boundary (with a face
-   * neighbour that is not bone) are cortical whatever their value: the
-   * partial-volume shell of the cortex. Default is true.
+   * Set/get whether the partial-volume shell of the cortex is cortical:
+   * grown voxels on the ramp (one or two voxels) from a cortical voxel out
+   * to what is not bone, whatever their value. Default is true.
    */
   vtkSetMacro(BoundaryIsCortical, bool);
   vtkGetMacro(BoundaryIsCortical, bool);

@@ -26,7 +26,7 @@ class vtkVolumeCutAmbientOcclusion
 {
 public:
   /// Darkening at full occlusion.
-  static constexpr double Strength = 0.75;
+  static constexpr double Strength = 0.9;
 
   vtkVolumeCutAmbientOcclusion(const vtkVolumeCutRayScene& scene, const vtkVolumeCutSampleClassifier& classifier)
     : Scene(scene)

@@ -195,7 +195,7 @@ public:
    * image: each surface point is darkened by the share of 14 points around
    * it, up to AmbientOcclusionRadius (mm) away over its normal's
    * hemisphere, that lie in visible material (cuts removed). Off by default;
-   * radius 4 mm.
+   * radius 6 mm.
    */
   vtkSetMacro(AmbientOcclusion, bool);
   vtkGetMacro(AmbientOcclusion, bool);
@@ -338,7 +338,7 @@ protected:
   double SpecularPower = 30.0;
   double LabelSmoothing = 0.0;
   bool AmbientOcclusion = false;
-  double AmbientOcclusionRadius = 4.0;
+  double AmbientOcclusionRadius = 6.0;
   int MaximumNumberOfThreads = 0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;

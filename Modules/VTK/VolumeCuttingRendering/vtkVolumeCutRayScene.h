@@ -88,7 +88,7 @@ struct vtkVolumeCutRayScene
   bool ThinBone = false;
   double ThinBoneThickness = 1.0;
   bool AmbientOcclusion = false;
-  double AmbientOcclusionRadius = 4.0;
+  double AmbientOcclusionRadius = 6.0;
   double Ambient = 0.25, Diffuse = 0.7, Specular = 0.2, SpecularPower = 20.0;
 };
 

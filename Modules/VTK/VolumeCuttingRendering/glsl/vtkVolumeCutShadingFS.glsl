@@ -93,7 +93,7 @@ bool enter(Sample piece, float t, int source)
   float alpha = style.a;
   if (ambientOcclusion != 0)
   {
-    rgb *= 1.0 - 0.75 * occlusion(index, normal);
+    rgb *= 1.0 - 0.9 * occlusion(index, normal);
   }
   if (thinBone != 0)
   {

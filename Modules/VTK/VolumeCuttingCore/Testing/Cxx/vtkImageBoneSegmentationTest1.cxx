@@ -162,7 +162,8 @@ int TestSmoothingAndDirection()
 // trabecular bone (450 HU), its outer boundary a partial-volume ramp down to
 // air over 2 mm, so the voxels the boundary crosses have trabecular-range
 // values. The paper's model (cortical boundary, trabecular interior) wants
-// them cortical; the interior stays trabecular.
+// them cortical. The interior, an air cell in its middle (2 mm), stays
+// trabecular: bone around air but away from the cortex is not its shell.
 int TestPartialVolumeShell()
 {
   vtkNew<vtkImageData> image;
@@ -178,7 +179,11 @@ int TestPartialVolumeShell()
       {
         const double p[3] = { double(i), double(j), double(k) };
         const double r = Distance(p, center);
-        const double value = r <= 6.0 ? 450.0 : r <= 10.0 ? 1500.0 : r >= 12.0 ? -1000.0 : 1500.0 - 2500.0 * (r - 10.0) / 2.0;
+        const double value = r <= 2.0 ? -1000.0
+          : r <= 6.0                 ? 450.0
+          : r <= 10.0                ? 1500.0
+          : r >= 12.0                ? -1000.0
+                                     : 1500.0 - 2500.0 * (r - 10.0) / 2.0;
         voxels[(k * 31 + j) * 31 + i] = static_cast<short>(value);
       }
     }
@@ -203,7 +208,7 @@ int TestPartialVolumeShell()
           const double r = Distance(p, center);
           const int label = static_cast<int>(labels->GetScalarComponentAsDouble(i, j, k, 0));
           ++counted[label];
-          if (r <= 5.0)
+          if (r > 2.0 && r <= 5.0)
           {
             CHECK_INT(label, vtkImageBoneSegmentation::TrabecularLabel);
           }
