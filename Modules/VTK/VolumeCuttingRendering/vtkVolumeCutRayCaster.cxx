@@ -104,6 +104,7 @@ struct vtkVolumeCutRayCaster::Internals
   double WorldToNDC[16];
   double NDCToWorld[16];
   vtkMTimeType SceneTime = 0;
+  bool LastDraftQuality = false;
   std::vector<float> OpaqueDepth;
   bool HadOpaqueDepth = false;
   std::vector<float> Color;
@@ -788,7 +789,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   impl.Scene.UnitDistance = this->ScalarOpacityUnitDistance;
   impl.Scene.ThinBone = this->ThinBoneShading;
   impl.Scene.ThinBoneThickness = this->ThinBoneThickness;
-  impl.Scene.AmbientOcclusion = this->AmbientOcclusion && this->BlendMode == IsoSurfaceBlend;
+  impl.Scene.AmbientOcclusion = this->AmbientOcclusion && !this->DraftQuality && this->BlendMode == IsoSurfaceBlend;
   impl.Scene.AmbientOcclusionRadius = this->AmbientOcclusionRadius;
   impl.Scene.Ambient = this->Ambient;
   impl.Scene.Diffuse = this->Diffuse;
@@ -976,7 +977,9 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     sameOpaque = impl.OpaqueDepth.size() == static_cast<size_t>(pixels) &&
       std::memcmp(opaqueDepth, impl.OpaqueDepth.data(), pixels * sizeof(float)) == 0;
   }
-  const bool localized = impl.ImageValid && sameCamera && sameOpaque && !sceneChanged;
+  const bool sameQuality = this->DraftQuality == impl.LastDraftQuality;
+  impl.LastDraftQuality = this->DraftQuality;
+  const bool localized = impl.ImageValid && sameCamera && sameOpaque && sameQuality && !sceneChanged;
 
   std::copy(matrix, matrix + 16, impl.WorldToNDC);
   vtkNew<vtkMatrix4x4> inverse;

@@ -205,6 +205,18 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Set/get whether renders leave ambient occlusion out although it is on:
+   * the mapper's frames drawn while the view moves. Unlike
+   * SetAmbientOcclusion it does not modify the caster, so that the
+   * empty-space structure is kept; the next render after a change recasts
+   * the whole image. Default is false.
+   */
+  void SetDraftQuality(bool draft) { this->DraftQuality = draft; }
+  bool GetDraftQuality() const { return this->DraftQuality; }
+  ///@}
+
+  ///@{
   /** Phong lighting with a headlight. */
   vtkSetMacro(Ambient, double);
   vtkGetMacro(Ambient, double);
@@ -339,6 +351,7 @@ protected:
   double LabelSmoothing = 0.0;
   bool AmbientOcclusion = false;
   double AmbientOcclusionRadius = 6.0;
+  bool DraftQuality = false;
   int MaximumNumberOfThreads = 0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;

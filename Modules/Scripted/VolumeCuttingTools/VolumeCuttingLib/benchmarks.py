@@ -488,6 +488,12 @@ def mapper(repeats: int) -> list[dict]:
     return mapperbenchmarks.mapper(repeats)
 
 
+def interactive(repeats: int) -> list[dict]:
+    from . import interactivebenchmarks
+
+    return interactivebenchmarks.interactive(repeats)
+
+
 def sliceview(repeats: int) -> list[dict]:
     from . import slicebenchmarks
 
@@ -498,6 +504,7 @@ AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
+    "interactive": interactive,
     "sliceview": sliceview,
 }
 

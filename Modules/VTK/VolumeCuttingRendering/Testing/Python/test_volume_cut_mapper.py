@@ -126,14 +126,15 @@ def add_cut_volume(scene, intensities, cut, renderer):
     return mapper, volume
 
 
-def read_window(window, width):
+def read_window(window, width, height=None):
+    height = height or width
     depth = vtk.vtkFloatArray()
-    window.GetZbufferData(0, 0, width - 1, width - 1, depth)
+    window.GetZbufferData(0, 0, width - 1, height - 1, depth)
     rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
+    window.GetRGBACharPixelData(0, 0, width - 1, height - 1, 1, rgba)
     return (
-        numpy_support.vtk_to_numpy(depth).reshape(width, width),
-        numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4).astype(int),
+        numpy_support.vtk_to_numpy(depth).reshape(height, width),
+        numpy_support.vtk_to_numpy(rgba).reshape(height, width, 4).astype(int),
     )
 
 
@@ -792,3 +793,72 @@ def test_binary_segments_are_smoothed_between_slices(scene, intensities):
         exact = world_center[0] + ellipsoid_radii[0] * np.sqrt(1.0 - u[inner] ** 2 - w[inner] ** 2)
         errors[smoothing] = float(np.sqrt(np.mean((points[..., 0][inner] - exact) ** 2)))
     assert errors[1.0] < 0.8 * errors[0.0]
+
+
+def test_interactive_frames_are_reduced_and_the_still_frame_is_the_full_image(scene, intensities):
+    width, height = 90, 70  # not multiples of the sample distance: the last block reaches past the edge
+    camera = A.make_camera(scene, 4.0, width, height)
+    cut = scene.cut_field(2)
+    # The image a view that never moved draws.
+    window, renderer = render_window(width, height)
+    renderer.SetActiveCamera(camera)
+    mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    # Moving frames leave ambient occlusion out; the refined one must not.
+    mapper.GetRayCaster().SetAmbientOcclusion(True)
+    window.Render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    full = read_window(window, width, height)
+
+    moving, moving_renderer = render_window(width, height)
+    moving_camera = vtk.vtkCamera()
+    moving_camera.DeepCopy(camera)
+    moving_renderer.SetActiveCamera(moving_camera)
+    moving_mapper, _ = add_cut_volume(scene, intensities, cut, moving_renderer)
+    moving_mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    moving_mapper.SetMaximumImageSampleDistance(4)
+    moving_mapper.GetRayCaster().SetAmbientOcclusion(True)
+    # The camera moves: the window asks for 1000 frames per second, more
+    # than any full frame gives, so every frame is the coarsest.
+    moving.SetDesiredUpdateRate(1000.0)
+    for angle in (5.0, -5.0):
+        moving_camera.Azimuth(angle)
+        moving.Render()
+        assert moving_mapper.GetLastImageSampleDistance() == 4
+        assert moving_mapper.GetRayCaster().GetNumberOfRaysCast() <= math.ceil(width / 4) * math.ceil(height / 4)
+    reduced = read_window(moving, width, height)
+    # Magnified, not shifted: the reduced image covers the same pixels as the
+    # full one but for the blocks along the silhouette.
+    covered_full, covered_reduced = full[0] < 1.0, reduced[0] < 1.0
+    assert np.mean(covered_full != covered_reduced) < 0.08
+    assert not np.array_equal(full[1], reduced[1])
+    # The motion stops: the window's rate drops back and the next frame is the full image.
+    moving.SetDesiredUpdateRate(0.0001)
+    moving.Render()
+    assert moving_mapper.GetLastImageSampleDistance() == 1
+    assert moving_mapper.GetRayCaster().GetNumberOfRaysCast() == width * height
+    refined = read_window(moving, width, height)
+    assert np.array_equal(refined[0], full[0])
+    assert np.array_equal(refined[1], full[1])
+
+
+def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
+    width = 128
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 4.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    window.Render()  # shaders and textures made
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    # A rate the last full frame meets leaves the image at full resolution;
+    # one that allows a sixteenth of it (within the maximum) reduces it to
+    # a ray per 4 x 4 pixels.
+    window.SetDesiredUpdateRate(0.5 / mapper.GetLastFrameTime())
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    window.SetDesiredUpdateRate(16.0 / mapper.GetLastFrameTime())
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    assert 4 <= mapper.GetLastImageSampleDistance() <= 5
