@@ -215,7 +215,8 @@ vtkMRMLSegmentationNode* vtkSlicerVolumeCuttingLogic::CreateBoneSegmentation(vtk
   vtkNew<vtkMatrix4x4> ijkToRas;
   anatomyVolume->GetIJKToRASMatrix(ijkToRas);
   const double corticalColor[3] = { 0.95, 0.91, 0.79 };
-  const double trabecularColor[3] = { 0.85, 0.70, 0.55 };
+  // Cancellous bone looks redder (marrow) than the cortex where a cut exposes it.
+  const double trabecularColor[3] = { 0.80, 0.52, 0.40 };
   vtkSegmentation* segmentation = segmentationNode->GetSegmentation();
   AddLabelAsSegment(segmentation, labels, vtkImageBoneSegmentation::CorticalLabel, ijkToRas, GetCorticalBoneSegmentID(), "Cortical bone", corticalColor);
   AddLabelAsSegment(segmentation, labels, vtkImageBoneSegmentation::TrabecularLabel, ijkToRas, GetTrabecularBoneSegmentID(), "Trabecular bone", trabecularColor);

@@ -145,10 +145,13 @@ void vtkMRMLVolumeCutNode::WriteXML(ostream& of, int nIndent)
   // checked against the previous protected list.
   vtkMRMLWriteXMLStdStringVectorMacro(protectedSegmentIDs, ProtectedSegmentIDs, std::vector);
   vtkMRMLWriteXMLStdStringVectorMacro(cuttableSegmentIDs, CuttableSegmentIDs, std::vector);
+  vtkMRMLWriteXMLStdStringVectorMacro(materialSegmentIDs, MaterialSegmentIDs, std::vector);
   vtkMRMLWriteXMLIntMacro(subVoxelFactor, SubVoxelFactor);
   vtkMRMLWriteXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
   vtkMRMLWriteXMLBooleanMacro(thinBoneShading, ThinBoneShading);
   vtkMRMLWriteXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
+  vtkMRMLWriteXMLBooleanMacro(ambientOcclusion, AmbientOcclusion);
+  vtkMRMLWriteXMLFloatMacro(labelSmoothing, LabelSmoothing);
   vtkMRMLWriteXMLBooleanMacro(sliceOutlineVisibility, SliceOutlineVisibility);
   vtkMRMLWriteXMLBooleanMacro(sliceFillVisibility, SliceFillVisibility);
   vtkMRMLWriteXMLFloatMacro(sliceFillOpacity, SliceFillOpacity);
@@ -165,10 +168,13 @@ void vtkMRMLVolumeCutNode::ReadXMLAttributes(const char** atts)
   vtkMRMLReadXMLBeginMacro(atts);
   vtkMRMLReadXMLStdStringVectorMacro(protectedSegmentIDs, ProtectedSegmentIDs, std::vector);
   vtkMRMLReadXMLStdStringVectorMacro(cuttableSegmentIDs, CuttableSegmentIDs, std::vector);
+  vtkMRMLReadXMLStdStringVectorMacro(materialSegmentIDs, MaterialSegmentIDs, std::vector);
   vtkMRMLReadXMLIntMacro(subVoxelFactor, SubVoxelFactor);
   vtkMRMLReadXMLFloatMacro(surfaceIsoValue, SurfaceIsoValue);
   vtkMRMLReadXMLBooleanMacro(thinBoneShading, ThinBoneShading);
   vtkMRMLReadXMLFloatMacro(thinBoneThickness, ThinBoneThickness);
+  vtkMRMLReadXMLBooleanMacro(ambientOcclusion, AmbientOcclusion);
+  vtkMRMLReadXMLFloatMacro(labelSmoothing, LabelSmoothing);
   vtkMRMLReadXMLBooleanMacro(sliceOutlineVisibility, SliceOutlineVisibility);
   vtkMRMLReadXMLBooleanMacro(sliceFillVisibility, SliceFillVisibility);
   vtkMRMLReadXMLFloatMacro(sliceFillOpacity, SliceFillOpacity);
@@ -202,10 +208,13 @@ void vtkMRMLVolumeCutNode::CopyContent(vtkMRMLNode* anode, bool deepCopy /*=true
   // source is not rejected against this node's old protected list.
   vtkMRMLCopyStdStringVectorMacro(ProtectedSegmentIDs);
   vtkMRMLCopyStdStringVectorMacro(CuttableSegmentIDs);
+  vtkMRMLCopyStdStringVectorMacro(MaterialSegmentIDs);
   vtkMRMLCopyIntMacro(SubVoxelFactor);
   vtkMRMLCopyFloatMacro(SurfaceIsoValue);
   vtkMRMLCopyBooleanMacro(ThinBoneShading);
   vtkMRMLCopyFloatMacro(ThinBoneThickness);
+  vtkMRMLCopyBooleanMacro(AmbientOcclusion);
+  vtkMRMLCopyFloatMacro(LabelSmoothing);
   vtkMRMLCopyBooleanMacro(SliceOutlineVisibility);
   vtkMRMLCopyBooleanMacro(SliceFillVisibility);
   vtkMRMLCopyFloatMacro(SliceFillOpacity);
@@ -221,10 +230,13 @@ void vtkMRMLVolumeCutNode::PrintSelf(ostream& os, vtkIndent indent)
   vtkMRMLPrintBeginMacro(os, indent);
   vtkMRMLPrintStdStringVectorMacro(CuttableSegmentIDs, std::vector);
   vtkMRMLPrintStdStringVectorMacro(ProtectedSegmentIDs, std::vector);
+  vtkMRMLPrintStdStringVectorMacro(MaterialSegmentIDs, std::vector);
   vtkMRMLPrintIntMacro(SubVoxelFactor);
   vtkMRMLPrintFloatMacro(SurfaceIsoValue);
   vtkMRMLPrintBooleanMacro(ThinBoneShading);
   vtkMRMLPrintFloatMacro(ThinBoneThickness);
+  vtkMRMLPrintBooleanMacro(AmbientOcclusion);
+  vtkMRMLPrintFloatMacro(LabelSmoothing);
   vtkMRMLPrintBooleanMacro(SliceOutlineVisibility);
   vtkMRMLPrintBooleanMacro(SliceFillVisibility);
   vtkMRMLPrintFloatMacro(SliceFillOpacity);
@@ -335,6 +347,19 @@ void vtkMRMLVolumeCutNode::SetCuttableSegmentIDs(const std::vector<std::string>&
   this->CuttableSegmentIDs = cuttable;
   this->Modified();
   this->InvokeCustomModifiedEvent(SegmentRolesModifiedEvent);
+}
+
+//----------------------------------------------------------------------------
+void vtkMRMLVolumeCutNode::SetMaterialSegmentIDs(const std::vector<std::string>& segmentIds)
+{
+  // In the given order: the first segment gives the material its colour.
+  const std::vector<std::string> material = Normalized(segmentIds);
+  if (material == this->MaterialSegmentIDs)
+  {
+    return;
+  }
+  this->MaterialSegmentIDs = material;
+  this->Modified();
 }
 
 //----------------------------------------------------------------------------

@@ -134,6 +134,18 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Segments made of one material (cortical and trabecular bone): their
+   * uncut surfaces are drawn in the colour of the first of them, as one
+   * bone; where a cut or clip plane opens them, each shows its own colour, so
+   * the cut surface tells which segment it exposes. Empty by default (every
+   * segment in its own colour).
+   */
+  void SetMaterialSegmentIDs(const std::vector<std::string>& segmentIds);
+  std::vector<std::string> GetMaterialSegmentIDs() const { return this->MaterialSegmentIDs; }
+  ///@}
+
+  ///@{
   /// Give a segment the cuttable or protected role, or take it away.
   /// Returns false, logs an error and changes nothing if no segmentation is
   /// referenced or the segmentation has no segment with this ID.
@@ -165,6 +177,27 @@ public:
   vtkBooleanMacro(ThinBoneShading, bool);
   vtkSetClampMacro(ThinBoneThickness, double, 0.05, 20.0);
   vtkGetMacro(ThinBoneThickness, double);
+  ///@}
+
+  ///@{
+  /**
+   * Ambient occlusion in the 3D view: a depth cue that darkens cavities
+   * (vtkVolumeCutRayCaster::SetAmbientOcclusion). Default is true.
+   */
+  vtkSetMacro(AmbientOcclusion, bool);
+  vtkGetMacro(AmbientOcclusion, bool);
+  vtkBooleanMacro(AmbientOcclusion, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Standard deviation (voxels) of the smoothing of segments drawn from
+   * binary labelmaps by their own shape, so that they look as smooth as
+   * Slicer's closed surfaces of them (vtkVolumeCutRayCaster::SetLabelSmoothing);
+   * 0 shows the voxels. Default is 1.
+   */
+  vtkSetClampMacro(LabelSmoothing, double, 0.0, 8.0);
+  vtkGetMacro(LabelSmoothing, double);
   ///@}
   ///@}
 
@@ -209,10 +242,13 @@ protected:
   vtkSmartPointer<vtkVolumeCutField> PreviewCutField;
   std::vector<std::string> CuttableSegmentIDs;
   std::vector<std::string> ProtectedSegmentIDs;
+  std::vector<std::string> MaterialSegmentIDs;
   int SubVoxelFactor{ 2 };
   double SurfaceIsoValue{ 300.0 };
   bool ThinBoneShading{ false };
   double ThinBoneThickness{ 1.0 };
+  bool AmbientOcclusion{ true };
+  double LabelSmoothing{ 1.0 };
 
   bool SliceOutlineVisibility{ true };
   bool SliceFillVisibility{ true };

@@ -29,6 +29,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkVolume.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -244,6 +245,8 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
   caster->SetIsoValue(node->GetSurfaceIsoValue());
   caster->SetThinBoneShading(node->GetThinBoneShading());
   caster->SetThinBoneThickness(node->GetThinBoneThickness());
+  caster->SetAmbientOcclusion(node->GetAmbientOcclusion());
+  caster->SetLabelSmoothing(node->GetLabelSmoothing());
 
   // Segments visible in 3D, in their colours.
   vtkMRMLSegmentationNode* segmentation = node->GetSegmentationNode();
@@ -308,6 +311,22 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
       const double opacity = display->GetSegmentOpacity3D(id);
       const double iso = node->IsSegmentCuttable(id) ? node->GetSurfaceIsoValue() : std::numeric_limits<double>::quiet_NaN();
       caster->SetSegmentAppearance(static_cast<int>(index + 1), color, opacity, iso);
+    }
+    // Segments of one material: uncut surfaces in the colour of the first.
+    const std::vector<std::string> material = node->GetMaterialSegmentIDs();
+    auto first = std::find_if(material.begin(), material.end(),
+      [&](const std::string& id) { return segmentation->GetSegmentation()->GetSegment(id) != nullptr; });
+    if (first != material.end())
+    {
+      double materialColor[3] = { 1.0, 1.0, 1.0 };
+      segmentation->GetSegmentation()->GetSegment(*first)->GetColor(materialColor);
+      for (size_t index = 0; index < shown.size(); ++index)
+      {
+        if (std::find(material.begin(), material.end(), shown[index]) != material.end())
+        {
+          caster->SetSegmentSurfaceColor(static_cast<int>(index + 1), materialColor);
+        }
+      }
     }
     pipeline.FractionSource = pipeline.LabelSource;
   }

@@ -156,6 +156,67 @@ int vtkImageBoneSegmentation::RequestData(
       }
     }
   }
+  if (this->BoundaryIsCortical)
+  {
+    // The partial-volume shell of the cortex, cortex by the paper's model:
+    // grown voxels on the ramp from the cortex (a cortical face neighbour)
+    // out to what is not bone. The shell is one or two voxels thick: its
+    // outer voxels touch the outside and the cortex, or a grown voxel of
+    // higher value that touches the cortex; its inner voxels touch the
+    // cortex and an outer voxel of lower value. Grown bone away from the
+    // cortex (septa between air cells) stays trabecular.
+    auto faceNeighbors = [&](vtkIdType index, vtkIdType neighbors[6]) {
+      const vtkIdType k = index / sliceSize;
+      const vtkIdType j = (index - k * sliceSize) / dims[0];
+      const vtkIdType i = index - k * sliceSize - j * dims[0];
+      neighbors[0] = i > 0 ? index - 1 : -1;
+      neighbors[1] = i + 1 < dims[0] ? index + 1 : -1;
+      neighbors[2] = j > 0 ? index - dims[0] : -1;
+      neighbors[3] = j + 1 < dims[1] ? index + dims[0] : -1;
+      neighbors[4] = k > 0 ? index - sliceSize : -1;
+      neighbors[5] = k + 1 < dims[2] ? index + sliceSize : -1;
+    };
+    auto touches = [&](vtkIdType index, auto&& predicate) {
+      vtkIdType neighbors[6];
+      faceNeighbors(index, neighbors);
+      return std::any_of(neighbors, neighbors + 6, [&](vtkIdType n) { return n >= 0 && predicate(n); });
+    };
+    const size_t firstGrown = static_cast<size_t>(this->NumberOfCorticalVoxels);
+    std::vector<unsigned char> state(static_cast<size_t>(voxelCount), 0); // 1: touches the cortex, 2: outer shell
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      state[queue[head]] = touches(queue[head], [&](vtkIdType n) { return labels[n] == CorticalLabel; }) ? 1 : 0;
+    }
+    std::vector<vtkIdType> outer;
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      const vtkIdType index = queue[head];
+      if (touches(index, [&](vtkIdType n) { return labels[n] == BackgroundLabel; }) &&
+        (state[index] == 1 || touches(index, [&](vtkIdType n) { return state[n] == 1 && values[n] > values[index]; })))
+      {
+        outer.push_back(index);
+      }
+    }
+    for (vtkIdType index : outer)
+    {
+      state[index] = 2;
+    }
+    std::vector<vtkIdType> shell = outer;
+    for (size_t head = firstGrown; head < queue.size(); ++head)
+    {
+      const vtkIdType index = queue[head];
+      if (state[index] == 1 && touches(index, [&](vtkIdType n) { return state[n] == 2 && values[n] < values[index]; }))
+      {
+        shell.push_back(index);
+      }
+    }
+    for (vtkIdType index : shell)
+    {
+      labels[index] = CorticalLabel;
+    }
+    this->NumberOfCorticalVoxels += static_cast<vtkIdType>(shell.size());
+    this->NumberOfTrabecularVoxels -= static_cast<vtkIdType>(shell.size());
+  }
   this->UpdateProgress(1.0);
   return 1;
 }
@@ -167,6 +228,7 @@ void vtkImageBoneSegmentation::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "CorticalThreshold: " << this->CorticalThreshold << "\n";
   os << indent << "TrabecularThreshold: " << this->TrabecularThreshold << "\n";
   os << indent << "SmoothingStandardDeviation: " << this->SmoothingStandardDeviation << "\n";
+  os << indent << "BoundaryIsCortical: " << this->BoundaryIsCortical << "\n";
   os << indent << "NumberOfCorticalVoxels: " << this->NumberOfCorticalVoxels << "\n";
   os << indent << "NumberOfTrabecularVoxels: " << this->NumberOfTrabecularVoxels << "\n";
 }

@@ -11,9 +11,14 @@
  *
  * Every voxel at or above CorticalThreshold seeds a region. Regions grow over
  * face-connected voxels at or above TrabecularThreshold. Grown voxels below
- * the cortical threshold are trabecular bone. Bright voxels that no cortical
- * seed reaches (calcifications, contrast, noise) are not bone: this
- * connectivity is what region growing adds to thresholding.
+ * the cortical threshold are trabecular bone, except the cortex's boundary
+ * (BoundaryIsCortical): the paper's bone model has a cortical boundary
+ * around a trabecular interior, and where cortex meets air or soft tissue
+ * the voxels the boundary passes through hold part cortex, part
+ * surroundings (partial volume), so their values fall in the trabecular
+ * range although they are cortex. Bright voxels that no cortical seed
+ * reaches (calcifications, contrast, noise) are not bone: this connectivity
+ * is what region growing adds to thresholding.
  *
  * The output is an unsigned char label image with the input's extent, origin,
  * spacing and direction: BackgroundLabel, CorticalLabel or TrabecularLabel.
@@ -60,6 +65,17 @@ public:
 
   ///@{
   /**
+   * Set/get whether the partial-volume shell of the cortex is cortical:
+   * grown voxels on the ramp (one or two voxels) from a cortical voxel out
+   * to what is not bone, whatever their value. Default is true.
+   */
+  vtkSetMacro(BoundaryIsCortical, bool);
+  vtkGetMacro(BoundaryIsCortical, bool);
+  vtkBooleanMacro(BoundaryIsCortical, bool);
+  ///@}
+
+  ///@{
+  /**
    * Set/get the standard deviation in millimetres of the Gaussian smoothing
    * applied before thresholding; 0 disables smoothing. Default is 0.
    */
@@ -85,6 +101,7 @@ protected:
   double CorticalThreshold = 700.0;
   double TrabecularThreshold = 200.0;
   double SmoothingStandardDeviation = 0.0;
+  bool BoundaryIsCortical = true;
   vtkIdType NumberOfCorticalVoxels = 0;
   vtkIdType NumberOfTrabecularVoxels = 0;
 

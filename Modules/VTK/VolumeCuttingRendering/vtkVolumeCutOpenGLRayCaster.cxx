@@ -3,8 +3,8 @@
 #include "vtkVolumeCutOpenGLRayCaster.h"
 
 #include "vtkVolumeCutField.h"
-#include "vtkVolumeCutRayCastFS.h"
 #include "vtkVolumeCutRayCaster.h"
+#include "vtkVolumeCutShaderComposer.h"
 
 #include <vtkIdList.h>
 #include <vtkMatrix4x4.h>
@@ -30,122 +30,6 @@ vtkStandardNewMacro(vtkVolumeCutOpenGLRayCaster);
 
 namespace
 {
-// The per-cut-field part of the shader; @N@ is the field's index.
-const char* const CutDeclarationTemplate = R"GLSL(
-uniform sampler3D cutPage@N@;
-uniform sampler3D cutAtlas@N@;
-uniform vec3 cutDimensionsF@N@;
-uniform int cutSlots@N@;
-uniform mat4 worldToSub@N@;
-uniform float cutQuantum@N@;
-uniform float cutStep@N@;
-uniform float cutCorrectionReach@N@; // in sample units
-ivec3 cutDimensions@N@;
-float cutSample@N@(ivec3 c)
-{
-  if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, cutDimensions@N@)))
-  {
-    return 32767.0;
-  }
-  ivec3 b = c / 8;
-  float slot = texelFetch(cutPage@N@, b, 0).r;
-  if (slot < 0.0)
-  {
-    return 32767.0;
-  }
-  int s = int(slot + 0.5);
-  ivec3 origin = 8 * ivec3(s % cutSlots@N@, (s / cutSlots@N@) % cutSlots@N@, s / (cutSlots@N@ * cutSlots@N@));
-  return texelFetch(cutAtlas@N@, origin + (c - 8 * b), 0).r;
-}
-float cutDistance@N@(vec3 world)
-{
-  vec3 index = (worldToSub@N@ * vec4(world, 1.0)).xyz;
-  ivec3 i0 = ivec3(floor(index));
-  vec3 f = index - vec3(i0);
-  float value = 0.0;
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    float w = cornerWeight(corner, f);
-    if (w != 0.0)
-    {
-      value += w * cutSample@N@(i0 + cornerOffset(corner));
-    }
-  }
-  // As vtkVolumeCutField::GetSignedDistance: the curvature correction only
-  // near the surface, where it matters.
-  if (abs(value) > cutCorrectionReach@N@)
-  {
-    return value * cutQuantum@N@;
-  }
-  // A second pass re-reads the corners rather than keeping them in arrays:
-  // arrays indexed at run time go to slow local memory on NVIDIA (measured
-  // on an H100: 179 ms a frame against 84 ms before the change).
-  vec3 second = vec3(0.0);
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    float w = cornerWeight(corner, f);
-    if (w == 0.0)
-    {
-      continue;
-    }
-    float center = cutSample@N@(i0 + cornerOffset(corner));
-    if (abs(center) == 32767.0)
-    {
-      continue;
-    }
-    ivec3 c = i0 + cornerOffset(corner);
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      ivec3 e = ivec3(0);
-      e[axis] = 1;
-      float n0 = cutSample@N@(c - e);
-      float n1 = cutSample@N@(c + e);
-      if (abs(n0) != 32767.0 && abs(n1) != 32767.0)
-      {
-        second[axis] += w * (n0 - 2.0 * center + n1);
-      }
-    }
-  }
-  value -= 0.5 * dot(f * (1.0 - f), second);
-  return value * cutQuantum@N@;
-}
-)GLSL";
-
-std::string Replace(std::string text, const std::string& what, const std::string& with)
-{
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + with.size()))
-  {
-    text.replace(at, what.size(), with);
-  }
-  return text;
-}
-
-std::string FragmentShader(int cuts)
-{
-  std::string declarations;
-  std::string calls;
-  std::string init;
-  std::ostringstream steps;
-  steps << "float cutStepOf(int n)\n{\n";
-  for (int n = 0; n < cuts; ++n)
-  {
-    const std::string index = std::to_string(n);
-    declarations += Replace(CutDeclarationTemplate, "@N@", index);
-    calls += "  if (n == " + index + ")\n  {\n    return cutDistance" + index + "(world);\n  }\n";
-    init += "  cutDimensions" + index + " = ivec3(cutDimensionsF" + index + " + 0.5);\n";
-    steps << "  if (n == " << n << ")\n  {\n    return cutStep" << n << ";\n  }\n";
-  }
-  steps << "  return 1.0;\n}\n";
-  std::string source = vtkVolumeCutRayCastFS;
-  const std::string defines =
-    "#define NUMBER_OF_CUTS " + std::to_string(cuts) + "\n#define CUT_SLOTS " + std::to_string(std::max(cuts, 1)) + "\n";
-  source = Replace(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
-  source = Replace(source, "//VolumeCut::CutDecl", declarations + steps.str());
-  source = Replace(source, "//VolumeCut::CutCalls", calls);
-  source = Replace(source, "//VolumeCut::CutInit", init);
-  return source;
-}
-
 void ColumnMajor(const double rowMajor[16], float out[16])
 {
   for (int row = 0; row < 4; ++row)
@@ -479,14 +363,15 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   }
   if (impl.SceneVersion != view.Version)
   {
-    std::vector<float> styles(8 * view.Styles.size());
+    std::vector<float> styles(12 * view.Styles.size());
     const int styleCount = static_cast<int>(view.Styles.size());
     for (int label = 0; label < styleCount; ++label)
     {
       std::copy(view.Styles[label].begin(), view.Styles[label].begin() + 4, styles.begin() + 4 * label);
-      std::copy(view.Styles[label].begin() + 4, view.Styles[label].end(), styles.begin() + 4 * (styleCount + label));
+      std::copy(view.Styles[label].begin() + 4, view.Styles[label].begin() + 8, styles.begin() + 4 * (styleCount + label));
+      std::copy(view.Styles[label].begin() + 8, view.Styles[label].end(), styles.begin() + 4 * (2 * styleCount + label));
     }
-    impl.Styles = Internals::Texture2D(window, styleCount, 2, 4, styles.data());
+    impl.Styles = Internals::Texture2D(window, styleCount, 3, 4, styles.data());
     const int* bd = view.BlockDimensions;
     const size_t blocks = static_cast<size_t>(bd[0]) * bd[1] * bd[2];
     std::vector<float> blockData(2 * blocks);
@@ -545,7 +430,9 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     {
       impl.Quad->ReleaseGraphicsResources(window);
     }
-    const std::string fragment = FragmentShader(cuts);
+    vtkVolumeCutShaderComposer::Features features;
+    features.CutFields = cuts;
+    const std::string fragment = vtkVolumeCutShaderComposer::FragmentShader(features);
     impl.Quad.reset(new vtkOpenGLQuadHelper(
       window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), fragment.c_str(), ""));
     impl.ShaderCuts = cuts;
@@ -616,6 +503,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniformi("tableSize", std::max(view.TableSize, 2));
   program->SetUniformi("thinBone", s->GetThinBoneShading() ? 1 : 0);
   program->SetUniformf("thinBoneThickness", static_cast<float>(s->GetThinBoneThickness()));
+  program->SetUniformi("ambientOcclusion", s->GetAmbientOcclusion() && s->GetBlendMode() == vtkVolumeCutRayCaster::IsoSurfaceBlend ? 1 : 0);
+  program->SetUniformf("ambientOcclusionRadius", static_cast<float>(s->GetAmbientOcclusionRadius()));
   program->SetUniformi("refinements", view.MaximumRefinements);
   const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
   float planes[6][4] = {};

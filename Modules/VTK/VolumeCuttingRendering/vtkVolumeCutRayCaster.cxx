@@ -2,16 +2,27 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutRayCaster.h"
 
+// The stages of adaptive sampling, one private header each (Pflesser et al.):
+// 1 classification, 2 border location, 3 piece classification, 4 shading.
+#include "vtkVolumeCutBorderLocator.h"
+#include "vtkVolumeCutCompositor.h"
+#include "vtkVolumeCutEmptySpace.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutLabelSmoothing.h"
+#include "vtkVolumeCutLocalizedUpdate.h"
+#include "vtkVolumeCutParallelFor.h"
+#include "vtkVolumeCutPieceClassifier.h"
+#include "vtkVolumeCutRayResult.h"
+#include "vtkVolumeCutRayScene.h"
+#include "vtkVolumeCutSampleClassifier.h"
+#include "vtkVolumeCutSurfaceShader.h"
 
 #include <vtkColorTransferFunction.h>
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
-#include <vtkIdList.h>
 #include <vtkImageData.h>
 #include <vtkIntArray.h>
 #include <vtkMath.h>
-#include <vtkMatrix3x3.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
@@ -19,7 +30,6 @@
 #include <vtkPlane.h>
 #include <vtkPlaneCollection.h>
 #include <vtkPointData.h>
-#include <vtkSMPTools.h>
 #include <vtkSmartPointer.h>
 
 #include <algorithm>
@@ -33,26 +43,16 @@
 
 vtkStandardNewMacro(vtkVolumeCutRayCaster);
 
+using vtkVolumeCutRayMath::Multiply4;
+using vtkVolumeCutRayMath::TransformPoint;
+using vtkVolumeCutRayMath::TransformVector;
+
 namespace
 {
-constexpr int MaximumCutFields = 8;
-constexpr int BlockSize = 8;
-constexpr int MaximumLayers = 8;
-constexpr int ObjectBisections = 22;
-constexpr int CutBisections = 22;
-constexpr int TransferTableSize = 4096;
-constexpr int MaximumRefinements = 4;
-constexpr int MaximumFractions = 16;
-constexpr float OpaqueAlpha = 0.995f;
-
-struct SegmentStyle
-{
-  float Color[3] = { 1.f, 1.f, 1.f };
-  float Opacity = 0.f;
-  float Iso = 0.f;
-  bool Shape = false; // the surface is the label's own indicator at 0.5
-  bool Defined = false;
-};
+constexpr int MaximumCutFields = vtkVolumeCutRayScene::MaximumCutFields;
+constexpr int MaximumFractions = vtkVolumeCutRayScene::MaximumFractions;
+constexpr int TransferTableSize = vtkVolumeCutRayScene::TransferTableSize;
+using SegmentStyle = vtkVolumeCutRayScene::SegmentStyle;
 
 struct CutEntry
 {
@@ -61,94 +61,18 @@ struct CutEntry
   bool Reported = false;
   vtkTypeUInt64 RenderedStamp = 0;
 };
-
-// One point of a ray and what is there.
-struct Sample
-{
-  double T = 0.0;
-  double Index[3] = { 0.0, 0.0, 0.0 };
-  int Object = 0;
-  float Value = 0.f;
-  bool CutsKnown = false;
-  double Distance[MaximumCutFields];
-};
-
-// A border between two samples: where it is and which volume forms it.
-struct Border
-{
-  double T;
-  int Source; // vtkVolumeCutRayCaster::SurfaceSources (SourceCutField + k for cut k)
-};
-
-void Multiply4(const double m[16], const double in[4], double out[4])
-{
-  for (int row = 0; row < 4; ++row)
-  {
-    out[row] = m[4 * row] * in[0] + m[4 * row + 1] * in[1] + m[4 * row + 2] * in[2] + m[4 * row + 3] * in[3];
-  }
-}
-
-void TransformPoint(const double m[16], const double in[3], double out[3])
-{
-  const double h[4] = { in[0], in[1], in[2], 1.0 };
-  double r[4];
-  Multiply4(m, h, r);
-  out[0] = r[0];
-  out[1] = r[1];
-  out[2] = r[2];
-}
-
-void TransformVector(const double m[16], const double in[3], double out[3])
-{
-  for (int row = 0; row < 3; ++row)
-  {
-    out[row] = m[4 * row] * in[0] + m[4 * row + 1] * in[1] + m[4 * row + 2] * in[2];
-  }
-}
-
-/// vtkSMPTools::For over [0, end) with at most maximumThreads threads (0: all
-/// cores). The VTK wheels start on the Sequential backend, which would leave a
-/// CPU reference that is meant to be multithreaded on one core: there the
-/// standard-thread backend is used for these loops only. Slicer's own build
-/// runs TBB and keeps it.
-template <typename Work>
-void ParallelFor(int maximumThreads, vtkIdType end, Work&& work)
-{
-  if (maximumThreads == 1)
-  {
-    work(vtkIdType(0), end);
-    return;
-  }
-  vtkSMPTools::Config config; // the active backend
-  if (std::strcmp(vtkSMPTools::GetBackend(), "Sequential") == 0)
-  {
-    config.Backend = "STDThread";
-  }
-  config.MaxNumberOfThreads = maximumThreads;
-  vtkSMPTools::LocalScope(config, [&] { vtkSMPTools::For(0, end, work); });
-}
 }
 
 //------------------------------------------------------------------------------
 struct vtkVolumeCutRayCaster::Internals
 {
-  // Anatomy
+  // Inputs, and when each was last copied into the scene.
   vtkSmartPointer<vtkImageData> Anatomy;
   vtkSmartPointer<vtkMatrix4x4> AnatomyMatrix;
   vtkMTimeType AnatomyCopyTime = 0;
-  std::vector<float> Values;
-  int Dimensions[3] = { 0, 0, 0 };
-  double IJKToWorld[16];
-  double WorldToIJK[16];
-
-  // Segments
   vtkSmartPointer<vtkImageData> LabelMap;
   vtkMTimeType LabelCopyTime = 0;
-  std::vector<uint16_t> Labels;
-  std::vector<SegmentStyle> Styles;
   bool DefaultStyles = true;
-
-  // Fractional labelmaps: per segment, the fraction (0..1) of each voxel.
   struct FractionInput
   {
     vtkSmartPointer<vtkImageData> Image;
@@ -156,33 +80,23 @@ struct vtkVolumeCutRayCaster::Internals
     double ValueAtOne = 1.0;
   };
   std::map<int, FractionInput> FractionInputs;
-  struct FractionVolume
-  {
-    int Label = 0;
-    std::vector<float> Values;
-  };
-  std::vector<FractionVolume> Fractions;
   vtkMTimeType FractionCopyTime = 0;
-
-  bool HasSegments() const { return !this->Labels.empty() || !this->Fractions.empty(); }
-
+  size_t CopiedFractionInputs = 0;
+  size_t GivenFractions = 0; // Scene.Fractions: the given ones first, then the smoothed ones
+  std::vector<int> SmoothedLabels;
+  double SmoothedSigma = 0.0;
+  vtkMTimeType SmoothedLabelVersion = 0;
   std::vector<CutEntry> Cuts;
+  std::vector<int> ActiveCuts; // indices into Cuts of the scene's cut fields
   vtkSmartPointer<vtkPlaneCollection> Planes;
   vtkSmartPointer<vtkColorTransferFunction> ColorFunction;
   vtkSmartPointer<vtkPiecewiseFunction> OpacityFunction;
-  std::vector<float> ColorTable;   // 3 per entry
-  std::vector<float> OpacityTable; // per entry, per ScalarOpacityUnitDistance
-  double TableRange[2] = { 0.0, 1.0 };
-
-  // Empty-space skipping: blocks of BlockSize^3 cells that may hold a visible object.
-  int BlockDimensions[3] = { 0, 0, 0 };
-  std::vector<uint8_t> BlockOccupied;
-  std::vector<float> BlockLipschitz; // bound of the CT's gradient (per voxel) in the block
-  bool AnyIsoSegment = false;
-  double MinimumIso = 0.0;
   vtkMTimeType BlockTime = 0;
   vtkMTimeType SceneVersion = 1;
   vtkMTimeType LabelVersion = 1; // changes when the label map or fractions are copied or dropped
+
+  /// What the rays read.
+  vtkVolumeCutRayScene Scene;
 
   // Last image, for localized updates.
   int Width = 0;
@@ -190,472 +104,38 @@ struct vtkVolumeCutRayCaster::Internals
   double WorldToNDC[16];
   double NDCToWorld[16];
   vtkMTimeType SceneTime = 0;
+  bool LastDraftQuality = false;
   std::vector<float> OpaqueDepth;
   bool HadOpaqueDepth = false;
   std::vector<float> Color;
   std::vector<float> Depth;
   std::vector<float> Normal;
   std::vector<int> Source;
+  std::vector<int> Segment;
   bool ImageValid = false;
 
-  // Per-frame constants copied from the caster so rays read plain members.
-  int BlendMode = 0;
-  double SampleDistance = 0.5;
-  double GradientStep = 0.3;
-  double UnitDistance = 1.0;
-  bool ThinBone = false;
-  double ThinBoneThickness = 1.0;
-  double Ambient = 0.25, Diffuse = 0.7, Specular = 0.2, SpecularPower = 20.0;
-  std::vector<int> ActiveCuts; // indices into Cuts of usable, non-empty fields
-  struct PlaneEquation
-  {
-    double Normal[3];
-    double Offset;
-  };
-  std::vector<PlaneEquation> PlaneEquations;
-
-  // ---- field evaluation -------------------------------------------------
-  // The cell holding p (clamped to the volume) and p's offsets in it.
-  void CellOf(const double p[3], int base[3], double f[3]) const
-  {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      const double x = std::min(std::max(p[axis], 0.0), double(this->Dimensions[axis] - 1));
-      base[axis] = std::min(static_cast<int>(x), this->Dimensions[axis] - 2);
-      f[axis] = x - base[axis];
-    }
-  }
-
-  float Interpolate(const double p[3]) const { return this->InterpolateArray(this->Values.data(), p); }
-
-  float InterpolateArray(const float* values, const double p[3]) const
-  {
-    int base[3];
-    double f[3];
-    this->CellOf(p, base, f);
-    const vtkIdType sx = 1;
-    const vtkIdType sy = this->Dimensions[0];
-    const vtkIdType sz = static_cast<vtkIdType>(this->Dimensions[0]) * this->Dimensions[1];
-    const float* v = values + base[0] + base[1] * sy + base[2] * sz;
-    const double c00 = v[0] + f[0] * (v[sx] - v[0]);
-    const double c10 = v[sy] + f[0] * (v[sy + sx] - v[sy]);
-    const double c01 = v[sz] + f[0] * (v[sz + sx] - v[sz]);
-    const double c11 = v[sz + sy] + f[0] * (v[sz + sy + sx] - v[sz + sy]);
-    const double c0 = c00 + f[1] * (c10 - c00);
-    const double c1 = c01 + f[1] * (c11 - c01);
-    return static_cast<float>(c0 + f[2] * (c1 - c0));
-  }
-
-  // The segment label with the largest trilinear weight among the cell's
-  // corners (hidden segments included, background not), and that weight (the
-  // label's interpolated indicator). Where two segments meet, their border is
-  // where their weights are equal, a smooth surface; where a segment meets
-  // the background, the CT's iso-surface (or the indicator at 0.5) decides.
-  int DominantLabel(const double p[3], double& weight) const
-  {
-    int base[3];
-    double f[3];
-    this->CellOf(p, base, f);
-    int labels[8 + MaximumFractions];
-    double weights[8 + MaximumFractions];
-    int count = 0;
-    double unlabelledBright = 0.0;
-    for (int corner = 0; corner < 8 && !this->Labels.empty(); ++corner)
-    {
-      const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
-      const vtkIdType voxel = c[0] + static_cast<vtkIdType>(this->Dimensions[0]) * (c[1] + static_cast<vtkIdType>(this->Dimensions[1]) * c[2]);
-      const int label = this->Labels[voxel];
-      const double w =
-        ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
-      if (label == 0)
-      {
-        // Material above the surface value that no shown segment claims
-        // competes like a segment: its border with a shown one is smooth,
-        // not the cell faces where a labelled voxel first counts.
-        if (this->AnyIsoSegment && this->Values[voxel] >= this->MinimumIso)
-        {
-          unlabelledBright += w;
-        }
-        continue;
-      }
-      int slot = 0;
-      while (slot < count && labels[slot] != label)
-      {
-        ++slot;
-      }
-      if (slot == count)
-      {
-        labels[count] = label;
-        weights[count++] = 0.0;
-      }
-      weights[slot] += w;
-    }
-    // A segment with a fractional labelmap weighs its interpolated fraction
-    // (the label map's indicator is its binary special case).
-    for (const FractionVolume& fraction : this->Fractions)
-    {
-      const double w = this->InterpolateArray(fraction.Values.data(), p);
-      int slot = 0;
-      while (slot < count && labels[slot] != fraction.Label)
-      {
-        ++slot;
-      }
-      if (slot == count)
-      {
-        labels[count++] = fraction.Label;
-      }
-      weights[slot] = w;
-    }
-    int best = 0;
-    weight = 0.0;
-    for (int slot = 0; slot < count; ++slot)
-    {
-      // Ties go to the lower label so that every path decides the same way.
-      if (weights[slot] > weight || (weights[slot] == weight && weight > 0.0 && labels[slot] < best))
-      {
-        best = labels[slot];
-        weight = weights[slot];
-      }
-    }
-    if (unlabelledBright > weight)
-    {
-      return 0;
-    }
-    return best;
-  }
-
-  // Interpolated indicator of one label (for shape-defined segments' normals).
-  double Indicator(int label, const double p[3]) const
-  {
-    for (const FractionVolume& fraction : this->Fractions)
-    {
-      if (fraction.Label == label)
-      {
-        return this->InterpolateArray(fraction.Values.data(), p);
-      }
-    }
-    if (this->Labels.empty())
-    {
-      return 0.0;
-    }
-    int base[3];
-    double f[3];
-    this->CellOf(p, base, f);
-    double value = 0.0;
-    for (int corner = 0; corner < 8; ++corner)
-    {
-      const int c[3] = { base[0] + (corner & 1), base[1] + ((corner >> 1) & 1), base[2] + ((corner >> 2) & 1) };
-      if (this->Labels[c[0] + static_cast<vtkIdType>(this->Dimensions[0]) * (c[1] + static_cast<vtkIdType>(this->Dimensions[1]) * c[2])] ==
-        label)
-      {
-        value += ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
-      }
-    }
-    return value;
-  }
-
-  // Which visible object is at p (0 for none), and the CT value there.
-  int ObjectAt(const double p[3], float& value) const
-  {
-    value = this->Interpolate(p);
-    if (!this->HasSegments())
-    {
-      const SegmentStyle& style = this->Styles[1];
-      return (style.Opacity > 0.f && value >= style.Iso) ? 1 : 0;
-    }
-    double weight = 0.0;
-    const int label = this->DominantLabel(p, weight);
-    if (label == 0 || label >= static_cast<int>(this->Styles.size()) || this->Styles[label].Opacity <= 0.f)
-    {
-      return 0; // background, or a hidden segment
-    }
-    const SegmentStyle& style = this->Styles[label];
-    const bool inside = style.Shape ? weight >= 0.5 : value >= style.Iso;
-    return inside ? label : 0;
-  }
-
-  void EvaluateObject(Sample& s) const { s.Object = this->ObjectAt(s.Index, s.Value); }
-
-  void WorldPoint(const double index[3], double world[3]) const { TransformPoint(this->IJKToWorld, index, world); }
-
-  void EvaluateCuts(Sample& s) const
-  {
-    if (s.CutsKnown)
-    {
-      return;
-    }
-    double world[3];
-    this->WorldPoint(s.Index, world);
-    for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-    {
-      s.Distance[n] = this->Cuts[this->ActiveCuts[n]].Field->GetSignedDistance(world);
-    }
-    s.CutsKnown = true;
-  }
-
-  bool Removed(const Sample& s) const
-  {
-    for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-    {
-      if (s.Distance[n] < 0.0)
-      {
-        return true;
-      }
-    }
-    return false;
-  }
-
-  bool Visible(Sample& s) const
-  {
-    if (s.Object == 0)
-    {
-      return false;
-    }
-    this->EvaluateCuts(s);
-    return !this->Removed(s);
-  }
-
-  // ---- normals (world, unit, pointing out of the visible material) ----
-  void ObjectNormal(int object, const double p[3], double normal[3]) const
-  {
-    const double h = this->GradientStep;
-    double gradient[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      double plus[3] = { p[0], p[1], p[2] };
-      double minus[3] = { p[0], p[1], p[2] };
-      plus[axis] += h;
-      minus[axis] -= h;
-      if (this->HasSegments() && this->Styles[object].Shape)
-      {
-        gradient[axis] = this->Indicator(object, plus) - this->Indicator(object, minus);
-      }
-      else
-      {
-        gradient[axis] = double(this->Interpolate(plus)) - double(this->Interpolate(minus));
-      }
-    }
-    // Outward: against the gradient of the inside-positive field.
-    TransformVector(this->NormalMatrix4(), gradient, normal);
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      normal[axis] = -normal[axis];
-    }
-    vtkMath::Normalize(normal);
-  }
-
-  void CutNormal(int n, const double world[3], double normal[3]) const
-  {
-    const vtkVolumeCutField* field = this->Cuts[this->ActiveCuts[n]].Field;
-    double spacing[3];
-    field->GetSubVoxelSpacing(spacing);
-    const double h = 0.25 * std::min({ spacing[0], spacing[1], spacing[2] });
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      double plus[3] = { world[0], world[1], world[2] };
-      double minus[3] = { world[0], world[1], world[2] };
-      plus[axis] += h;
-      minus[axis] -= h;
-      // The material's outward normal points into the removed region, where
-      // the distance decreases.
-      normal[axis] = field->GetSignedDistance(minus) - field->GetSignedDistance(plus);
-    }
-    vtkMath::Normalize(normal);
-  }
-
-  // Inverse transpose of IJK-to-world's linear part (4x4, row-major): maps
-  // IJK gradients to world normals.
-  double NormalMatrix4Storage[16];
-  const double* NormalMatrix4() const { return this->NormalMatrix4Storage; }
-
-  // ---- borders --------------------------------------------------------
-  Sample At(const double origin[3], const double direction[3], double t) const
-  {
-    Sample s;
-    s.T = t;
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      s.Index[axis] = origin[axis] + t * direction[axis];
-    }
-    return s;
-  }
-
-  double BisectObject(const double o[3], const double d[3], const Sample& a, const Sample& b) const
-  {
-    double lo = a.T;
-    double hi = b.T;
-    for (int iteration = 0; iteration < ObjectBisections; ++iteration)
-    {
-      Sample mid = this->At(o, d, 0.5 * (lo + hi));
-      this->EvaluateObject(mid);
-      (mid.Object == a.Object ? lo : hi) = mid.T;
-    }
-    return 0.5 * (lo + hi);
-  }
-
-  double BisectCut(int n, const double o[3], const double d[3], const Sample& a, const Sample& b) const
-  {
-    const vtkVolumeCutField* field = this->Cuts[this->ActiveCuts[n]].Field;
-    double lo = a.T;
-    double hi = b.T;
-    const bool loRemoved = a.Distance[n] < 0.0;
-    for (int iteration = 0; iteration < CutBisections; ++iteration)
-    {
-      const double t = 0.5 * (lo + hi);
-      double index[3];
-      double world[3];
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        index[axis] = o[axis] + t * d[axis];
-      }
-      this->WorldPoint(index, world);
-      ((field->GetSignedDistance(world) < 0.0) == loRemoved ? lo : hi) = t;
-    }
-    return 0.5 * (lo + hi);
-  }
-
-  // ---- transfer functions ---------------------------------------------
-  void LookUp(float value, float color[3], float& opacity) const
-  {
-    const double span = this->TableRange[1] - this->TableRange[0];
-    double x = span > 0.0 ? (value - this->TableRange[0]) / span * (TransferTableSize - 1) : 0.0;
-    x = std::min(std::max(x, 0.0), double(TransferTableSize - 1));
-    const int i = std::min(static_cast<int>(x), TransferTableSize - 2);
-    const float f = static_cast<float>(x - i);
-    for (int c = 0; c < 3; ++c)
-    {
-      color[c] = this->ColorTable[3 * i + c] * (1.f - f) + this->ColorTable[3 * (i + 1) + c] * f;
-    }
-    opacity = this->OpacityTable[i] * (1.f - f) + this->OpacityTable[i + 1] * f;
-  }
-
-  bool BlockEmpty(const double p[3]) const
-  {
-    int b[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      b[axis] = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->BlockDimensions[axis] - 1);
-    }
-    return !this->BlockOccupied[b[0] + this->BlockDimensions[0] * (b[1] + this->BlockDimensions[1] * b[2])];
-  }
-
-  // Ray parameter where the ray leaves the block holding p.
-  double BlockExit(const double p[3], const double d[3], double t) const
-  {
-    double exit = std::numeric_limits<double>::infinity();
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      if (std::abs(d[axis]) < 1e-12)
-      {
-        continue;
-      }
-      const int b = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->BlockDimensions[axis] - 1);
-      const double wall = d[axis] > 0.0 ? double((b + 1) * BlockSize) : double(b * BlockSize);
-      exit = std::min(exit, t + (wall - p[axis]) / d[axis]);
-    }
-    return exit;
-  }
-
-  float BlockValue(const std::vector<float>& values, const double p[3]) const
-  {
-    int b[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      b[axis] = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->BlockDimensions[axis] - 1);
-    }
-    return values[b[0] + this->BlockDimensions[0] * (b[1] + this->BlockDimensions[1] * b[2])];
-  }
-
-  // Whether a border could lie between two samples without showing at them:
-  // bounds from the CT's largest gradient in the blocks (voxels) and from the
-  // cut fields being distances (1 mm per mm).
-  bool MayHideBorders(const Sample& a, const Sample& b, double lengthVoxels, double lengthMillimetres) const
-  {
-    if (a.Object == 0 && b.Object == 0)
-    {
-      if (!this->AnyIsoSegment)
-      {
-        return false;
-      }
-      const double slope = std::max(this->BlockValue(this->BlockLipschitz, a.Index), this->BlockValue(this->BlockLipschitz, b.Index));
-      return 0.5 * (double(a.Value) + double(b.Value) + slope * lengthVoxels) >= this->MinimumIso;
-    }
-    if (!a.CutsKnown || !b.CutsKnown)
-    {
-      return false;
-    }
-    for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-    {
-      const double da = a.Distance[n];
-      const double db = b.Distance[n];
-      if ((da >= 0.0) == (db >= 0.0) && std::abs(da) + std::abs(db) < lengthMillimetres)
-      {
-        return true;
-      }
-    }
-    return false;
-  }
-
-  void Shade(const float color[3], const double normal[3], const double view[3], float out[3]) const
-  {
-    // Headlight: the light comes from the eye, so the half vector is the view.
-    const double cosine = std::abs(vtkMath::Dot(normal, view));
-    const double specular = this->Specular * std::pow(cosine, this->SpecularPower);
-    for (int c = 0; c < 3; ++c)
-    {
-      out[c] = static_cast<float>(std::min(1.0, color[c] * (this->Ambient + this->Diffuse * cosine) + specular));
-    }
-  }
-
-  double MeasureThickness(const double index[3], const double normalWorld[3]) const;
   void CastRay(int x, int y, const double* opaqueLimit);
 };
 
 //------------------------------------------------------------------------------
-double vtkVolumeCutRayCaster::Internals::MeasureThickness(const double index[3], const double normalWorld[3]) const
-{
-  // March inward (against the outward normal) until the visible material
-  // ends, in steps of a quarter voxel, up to the threshold.
-  double inward[3] = { -normalWorld[0], -normalWorld[1], -normalWorld[2] };
-  double inwardIndex[3];
-  TransformVector(this->WorldToIJK, inward, inwardIndex);
-  const double voxelsPerMillimetre = vtkMath::Norm(inwardIndex);
-  if (voxelsPerMillimetre <= 0.0)
-  {
-    return this->ThinBoneThickness;
-  }
-  const double step = 0.25 / voxelsPerMillimetre;
-  for (double travelled = step; travelled < this->ThinBoneThickness; travelled += step)
-  {
-    Sample s;
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      s.Index[axis] = index[axis] + travelled * inwardIndex[axis];
-      if (s.Index[axis] < 0.0 || s.Index[axis] > this->Dimensions[axis] - 1)
-      {
-        return this->ThinBoneThickness;
-      }
-    }
-    // Bone is bone whatever its segment (cortical over trabecular): the wall
-    // ends where no visible material is left.
-    this->EvaluateObject(s);
-    if (!this->Visible(s))
-    {
-      return travelled;
-    }
-  }
-  return this->ThinBoneThickness;
-}
-
-//------------------------------------------------------------------------------
+// One ray, from the eye through the pixel's centre: the stages of adaptive
+// sampling along it, or the compositor in composite mode.
 void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqueLimit)
 {
+  const vtkVolumeCutRayScene& scene = this->Scene;
   const vtkIdType pixel = static_cast<vtkIdType>(y) * this->Width + x;
-  float* color = &this->Color[4 * pixel];
-  std::fill(color, color + 4, 0.f);
-  this->Depth[pixel] = 1.f;
-  std::fill(&this->Normal[3 * pixel], &this->Normal[3 * pixel] + 3, 0.f);
-  this->Source[pixel] = SourceNone;
+  vtkVolumeCutRayResult result;
+  result.Color = &this->Color[4 * pixel];
+  result.Depth = &this->Depth[pixel];
+  result.Normal = &this->Normal[3 * pixel];
+  result.Source = &this->Source[pixel];
+  result.Segment = &this->Segment[pixel];
+  result.WorldToNDC = this->WorldToNDC;
+  std::fill(result.Color, result.Color + 4, 0.f);
+  *result.Depth = 1.f;
+  std::fill(result.Normal, result.Normal + 3, 0.f);
+  *result.Source = SourceNone;
+  *result.Segment = 0;
 
   // The ray through the pixel's centre, from the near to the far plane.
   const double ndcX = 2.0 * (x + 0.5) / this->Width - 1.0;
@@ -666,370 +146,107 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
   double farW[4];
   Multiply4(this->NDCToWorld, nearH, nearW);
   Multiply4(this->NDCToWorld, farH, farW);
-  double originWorld[3];
-  double directionWorld[3];
+  vtkVolumeCutRay ray;
   for (int axis = 0; axis < 3; ++axis)
   {
-    originWorld[axis] = nearW[axis] / nearW[3];
-    directionWorld[axis] = farW[axis] / farW[3] - originWorld[axis];
+    ray.OriginWorld[axis] = nearW[axis] / nearW[3];
+    ray.DirectionWorld[axis] = farW[axis] / farW[3] - ray.OriginWorld[axis];
   }
-  double tEnd = vtkMath::Normalize(directionWorld);
+  ray.TEnd = vtkMath::Normalize(ray.DirectionWorld);
   if (opaqueLimit)
   {
-    tEnd = std::min(tEnd, *opaqueLimit);
+    ray.TEnd = std::min(ray.TEnd, *opaqueLimit);
   }
-  const double view[3] = { -directionWorld[0], -directionWorld[1], -directionWorld[2] };
-
-  double o[3];
-  double d[3];
-  TransformPoint(this->WorldToIJK, originWorld, o);
-  TransformVector(this->WorldToIJK, directionWorld, d);
-
-  // Entry and exit: the volume's box (sample domain), then the clip planes.
-  double tStart = 0.0;
-  int entrySource = SourceClipPlane; // the near plane, when the eye is inside
-  double entryNormal[3] = { view[0], view[1], view[2] };
   for (int axis = 0; axis < 3; ++axis)
   {
-    const double lo = 0.0;
-    const double hi = this->Dimensions[axis] - 1.0;
-    if (std::abs(d[axis]) < 1e-15)
-    {
-      if (o[axis] < lo || o[axis] > hi)
-      {
-        return;
-      }
-      continue;
-    }
-    double t0 = (lo - o[axis]) / d[axis];
-    double t1 = (hi - o[axis]) / d[axis];
-    const bool forward = t0 < t1;
-    if (!forward)
-    {
-      std::swap(t0, t1);
-    }
-    if (t0 > tStart)
-    {
-      tStart = t0;
-      entrySource = SourceVolumeBox;
-      double faceNormal[3] = { 0.0, 0.0, 0.0 };
-      faceNormal[axis] = forward ? -1.0 : 1.0;
-      TransformVector(this->NormalMatrix4(), faceNormal, entryNormal);
-      vtkMath::Normalize(entryNormal);
-    }
-    tEnd = std::min(tEnd, t1);
+    ray.View[axis] = -ray.DirectionWorld[axis];
   }
-  for (const PlaneEquation& plane : this->PlaneEquations)
-  {
-    const double f0 = vtkMath::Dot(plane.Normal, originWorld) + plane.Offset;
-    const double fd = vtkMath::Dot(plane.Normal, directionWorld);
-    if (std::abs(fd) < 1e-15)
-    {
-      if (f0 < 0.0)
-      {
-        return;
-      }
-      continue;
-    }
-    const double t = -f0 / fd;
-    if (fd > 0.0)
-    {
-      if (t > tStart)
-      {
-        tStart = t;
-        entrySource = SourceClipPlane;
-        for (int axis = 0; axis < 3; ++axis)
-        {
-          entryNormal[axis] = -plane.Normal[axis];
-        }
-        vtkMath::Normalize(entryNormal);
-      }
-    }
-    else
-    {
-      tEnd = std::min(tEnd, t);
-    }
-  }
-  if (!(tStart < tEnd))
+  TransformPoint(scene.WorldToIJK, ray.OriginWorld, ray.Origin);
+  TransformVector(scene.WorldToIJK, ray.DirectionWorld, ray.Direction);
+
+  const vtkVolumeCutSampleClassifier classifier(scene);
+  const vtkVolumeCutBorderLocator locator(scene, classifier);
+  const vtkVolumeCutSurfaceShader shader(scene, classifier);
+  // Entry and exit: the volume's box (sample domain), then the clip planes.
+  if (!locator.ClipToVolume(ray))
   {
     return;
   }
+  const double* o = ray.Origin;
+  const double* d = ray.Direction;
+  const double tEnd = ray.TEnd;
 
   // World length of one voxel step along this ray.
-  const double voxelsPerMillimetre = vtkMath::Norm(d);
-  const double step = this->SampleDistance / voxelsPerMillimetre;
-  const bool composite = this->BlendMode == CompositeBlend;
-
-  int layers = 0;
-  bool first = true;
-  auto record = [&](double t, int source, const double normal[3], const float rgb[3], float alpha, float minimumAlpha) {
-    const float remaining = 1.f - color[3];
-    for (int c = 0; c < 3; ++c)
+  ray.VoxelsPerMillimetre = vtkMath::Norm(d);
+  const double step = scene.SampleDistance / ray.VoxelsPerMillimetre;
+  const bool composite = scene.BlendMode == CompositeBlend;
+  const vtkVolumeCutEmptySpace& emptySpace = scene.EmptySpace;
+  // Nothing visible in the sample's block: jump it to where the ray leaves it, unless
+  // that is within a step.
+  auto skipBlock = [&](vtkVolumeCutSample& sample) -> bool {
+    const double exit = std::min(emptySpace.Exit(sample.Index, d, sample.T) + 1e-9, tEnd);
+    if (!(exit > sample.T + step))
     {
-      color[c] += remaining * alpha * rgb[c];
-    }
-    color[3] += remaining * alpha;
-    if (first && alpha >= minimumAlpha)
-    {
-      first = false;
-      double world[4] = { originWorld[0] + t * directionWorld[0], originWorld[1] + t * directionWorld[1],
-        originWorld[2] + t * directionWorld[2], 1.0 };
-      double clip[4];
-      Multiply4(this->WorldToNDC, world, clip);
-      this->Depth[pixel] = static_cast<float>(std::min(1.0, std::max(0.0, 0.5 * clip[2] / clip[3] + 0.5)));
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        this->Normal[3 * pixel + axis] = static_cast<float>(normal[axis]);
-      }
-      this->Source[pixel] = source;
-    }
-  };
-
-  // A visible piece starts at a border: shade it with that border's normal.
-  auto enter = [&](const Sample& piece, double t, int source) -> bool {
-    double normal[3];
-    double index[3];
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      index[axis] = o[axis] + t * d[axis];
-    }
-    if (source == SourceObject)
-    {
-      this->ObjectNormal(piece.Object, index, normal);
-    }
-    else if (source >= SourceCutField)
-    {
-      double world[3];
-      this->WorldPoint(index, world);
-      this->CutNormal(source - SourceCutField, world, normal);
-    }
-    else
-    {
-      std::copy(entryNormal, entryNormal + 3, normal);
-    }
-    if (vtkMath::Dot(normal, view) < 0.0)
-    {
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        normal[axis] = -normal[axis];
-      }
-    }
-    const SegmentStyle& style = this->Styles[piece.Object];
-    float rgb[3];
-    this->Shade(style.Color, normal, view, rgb);
-    float alpha = style.Opacity;
-    if (this->ThinBone)
-    {
-      const double thickness = this->MeasureThickness(index, normal);
-      if (thickness < this->ThinBoneThickness)
-      {
-        const float f = static_cast<float>(thickness / this->ThinBoneThickness);
-        const float red[3] = { 1.f, 0.12f, 0.08f };
-        for (int c = 0; c < 3; ++c)
-        {
-          rgb[c] = red[c] * (1.f - f) + rgb[c] * f;
-        }
-        alpha *= 0.3f + 0.7f * f;
-      }
-    }
-    record(t, source, normal, rgb, alpha, 0.f);
-    return color[3] >= OpaqueAlpha || ++layers >= MaximumLayers;
-  };
-
-  // Iso-surface mode: the borders between two samples, found one volume at a
-  // time, and the first visible piece between them. Where a border could
-  // hide between the samples (a grazing ray through a thin sliver of an
-  // object or of a cut), the interval is halved first.
-  // Every border of every volume between two samples, in ray order: the
-  // object's (iso-surface mode) and each cut field's.
-  auto findBorders = [&](const Sample& a, const Sample& b, bool withObject, Border* borders) -> int {
-    int count = 0;
-    if (withObject && a.Object != b.Object)
-    {
-      borders[count++] = { this->BisectObject(o, d, a, b), SourceObject };
-    }
-    if (a.CutsKnown && b.CutsKnown)
-    {
-      for (size_t n = 0; n < this->ActiveCuts.size(); ++n)
-      {
-        if ((a.Distance[n] < 0.0) != (b.Distance[n] < 0.0))
-        {
-          borders[count++] = { this->BisectCut(static_cast<int>(n), o, d, a, b), SourceCutField + static_cast<int>(n) };
-        }
-      }
-    }
-    std::sort(borders, borders + count, [](const Border& l, const Border& r) { return l.T < r.T; });
-    return count;
-  };
-
-  bool insideVisible = false;
-  auto surfaceInterval = [&](auto& self, Sample& a, Sample& b, int depth) -> bool {
-    if (a.Object != 0 || b.Object != 0)
-    {
-      this->EvaluateCuts(a);
-      this->EvaluateCuts(b);
-    }
-    if (depth == 0 && this->MayHideBorders(a, b, (b.T - a.T) * voxelsPerMillimetre, b.T - a.T))
-    {
-      // Sub-steps of 1/2^MaximumRefinements of the interval, as the GPU does.
-      constexpr int parts = 1 << MaximumRefinements;
-      Sample from = a;
-      for (int part = 1; part <= parts; ++part)
-      {
-        Sample to = part == parts ? b : this->At(o, d, a.T + (b.T - a.T) * part / parts);
-        if (part < parts)
-        {
-          this->EvaluateObject(to);
-        }
-        if (self(self, from, to, 1))
-        {
-          return true;
-        }
-        from = to;
-      }
-      b = from;
       return false;
     }
-    Border borders[MaximumCutFields + 1];
-    const int count = findBorders(a, b, true, borders);
-    for (int border = 0; border < count; ++border)
-    {
-      const double end = border + 1 < count ? borders[border + 1].T : b.T;
-      Sample mid = this->At(o, d, 0.5 * (borders[border].T + end));
-      this->EvaluateObject(mid);
-      const bool visible = this->Visible(mid);
-      if (visible && !insideVisible && enter(mid, borders[border].T, borders[border].Source))
-      {
-        return true;
-      }
-      insideVisible = visible;
-    }
-    return false;
+    sample = vtkVolumeCutSample::At(o, d, exit);
+    classifier.EvaluateObject(sample);
+    return true;
   };
 
-  Sample a = this->At(o, d, tStart);
-  this->EvaluateObject(a);
   if (composite)
   {
-    this->EvaluateCuts(a);
-  }
-  insideVisible = !composite && this->Visible(a);
-  if (insideVisible && enter(a, tStart, entrySource))
-  {
-    return;
-  }
-  int lastCutBorder = -1; // composite: the cut whose border a piece starts at
-
-  while (a.T < tEnd)
-  {
-    if (a.Object == 0 && !composite && this->BlockEmpty(a.Index))
+    const vtkVolumeCutCompositor compositor(scene, classifier, locator, shader);
+    vtkVolumeCutSample a = vtkVolumeCutSample::At(o, d, ray.TStart);
+    classifier.EvaluateObject(a);
+    classifier.EvaluateCuts(a);
+    int lastCutBorder = -1; // the cut whose border the next piece starts at
+    while (a.T < tEnd)
     {
-      // Nothing visible in this block: jump to where the ray leaves it.
-      const double exit = std::min(this->BlockExit(a.Index, d, a.T) + 1e-9, tEnd);
-      if (exit > a.T + step)
+      if (emptySpace.Empty(a.Index) && skipBlock(a))
       {
-        a = this->At(o, d, exit);
-        this->EvaluateObject(a);
-        insideVisible = this->Visible(a);
-        if (insideVisible && enter(a, a.T, SourceObject))
-        {
-          return;
-        }
-        continue;
-      }
-    }
-    else if (composite && this->BlockEmpty(a.Index))
-    {
-      const double exit = std::min(this->BlockExit(a.Index, d, a.T) + 1e-9, tEnd);
-      if (exit > a.T + step)
-      {
-        a = this->At(o, d, exit);
-        this->EvaluateObject(a);
-        this->EvaluateCuts(a);
+        classifier.EvaluateCuts(a);
         lastCutBorder = -1;
         continue;
       }
-    }
-
-    Sample b = this->At(o, d, std::min(a.T + step, tEnd));
-    this->EvaluateObject(b);
-    if (!composite)
-    {
-      if (surfaceInterval(surfaceInterval, a, b, 0))
+      vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
+      classifier.EvaluateObject(b);
+      if (compositor.Step(ray, a, b, lastCutBorder, result))
       {
         return;
       }
       a = b;
+    }
+    return;
+  }
+
+  // Iso-surface mode: samples every SampleDistance voxels, classified (step
+  // 1); between two, the borders and pieces (steps 2 and 3), the first
+  // visible piece shaded (step 4).
+  const vtkVolumeCutPieceClassifier pieces(classifier, locator, shader);
+  vtkVolumeCutSample a = vtkVolumeCutSample::At(o, d, ray.TStart);
+  classifier.EvaluateObject(a);
+  bool insideVisible = classifier.Visible(a);
+  if (insideVisible && shader.Enter(ray, a, ray.TStart, ray.EntrySource, result))
+  {
+    return;
+  }
+  while (a.T < tEnd)
+  {
+    if (a.Object == 0 && emptySpace.Empty(a.Index) && skipBlock(a))
+    {
+      insideVisible = classifier.Visible(a);
+      if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
+      {
+        return;
+      }
       continue;
     }
-    this->EvaluateCuts(a);
-    this->EvaluateCuts(b);
-
-    // Every cut's border between a and b.
-    Border borders[MaximumCutFields + 1];
-    const int count = findBorders(a, b, false, borders);
-
-    // Front-to-back compositing of the pieces outside every cut.
-    double start = a.T;
-    for (int piece = 0; piece <= count; ++piece)
+    vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
+    classifier.EvaluateObject(b);
+    if (pieces.Interval(ray, a, b, insideVisible, result))
     {
-      const double end = piece < count ? borders[piece].T : b.T;
-      if (end > start)
-      {
-        Sample mid = this->At(o, d, 0.5 * (start + end));
-        this->EvaluateObject(mid);
-        this->EvaluateCuts(mid);
-        if (!this->Removed(mid))
-        {
-          float rgb[3];
-          float opacity;
-          this->LookUp(mid.Value, rgb, opacity);
-          if (opacity > 0.f)
-          {
-            const float alpha = 1.f - std::pow(1.f - std::min(opacity, 0.9999f), static_cast<float>((end - start) / this->UnitDistance));
-            double normal[3];
-            int source = SourceObject;
-            if (lastCutBorder >= 0)
-            {
-              // The first piece after a cut border shows the cut surface.
-              double world[3];
-              this->WorldPoint(mid.Index, world);
-              this->CutNormal(lastCutBorder, world, normal);
-              source = SourceCutField + lastCutBorder;
-            }
-            else
-            {
-              // Composite mode shades with the CT's gradient whatever the labels.
-              double gradient[3];
-              for (int axis = 0; axis < 3; ++axis)
-              {
-                double plus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
-                double minus[3] = { mid.Index[0], mid.Index[1], mid.Index[2] };
-                plus[axis] += this->GradientStep;
-                minus[axis] -= this->GradientStep;
-                gradient[axis] = double(this->Interpolate(minus)) - double(this->Interpolate(plus));
-              }
-              TransformVector(this->NormalMatrix4(), gradient, normal);
-              vtkMath::Normalize(normal);
-            }
-            float shaded[3];
-            this->Shade(rgb, normal, view, shaded);
-            // Depth and normal belong to the first piece that clearly shows.
-            // (a cut surface is a surface: its first piece always counts).
-            record(start, source, normal, shaded, alpha, lastCutBorder >= 0 ? 0.f : 0.02f);
-            if (color[3] >= OpaqueAlpha)
-            {
-              return;
-            }
-          }
-          lastCutBorder = -1;
-        }
-      }
-      if (piece < count)
-      {
-        lastCutBorder = borders[piece].Source >= SourceCutField ? borders[piece].Source - SourceCutField : -1;
-      }
-      start = end;
+      return;
     }
     a = b;
   }
@@ -1039,7 +256,7 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
 vtkVolumeCutRayCaster::vtkVolumeCutRayCaster()
   : Impl(new Internals)
 {
-  this->Impl->Styles.resize(2);
+  this->Impl->Scene.Styles.resize(2);
 }
 
 //------------------------------------------------------------------------------
@@ -1121,17 +338,18 @@ void vtkVolumeCutRayCaster::SetSegmentAppearance(int label, const double color[3
   }
   if (this->Impl->DefaultStyles)
   {
-    this->Impl->Styles.assign(2, SegmentStyle());
+    this->Impl->Scene.Styles.assign(2, SegmentStyle());
     this->Impl->DefaultStyles = false;
   }
-  if (static_cast<int>(this->Impl->Styles.size()) <= label)
+  if (static_cast<int>(this->Impl->Scene.Styles.size()) <= label)
   {
-    this->Impl->Styles.resize(label + 1);
+    this->Impl->Scene.Styles.resize(label + 1);
   }
-  SegmentStyle& style = this->Impl->Styles[label];
+  SegmentStyle& style = this->Impl->Scene.Styles[label];
   for (int c = 0; c < 3; ++c)
   {
     style.Color[c] = static_cast<float>(std::min(1.0, std::max(0.0, color[c])));
+    style.SurfaceColor[c] = style.Color[c];
   }
   style.Opacity = std::isfinite(opacity) ? static_cast<float>(std::min(1.0, std::max(0.0, opacity))) : 0.f;
   style.Shape = std::isnan(isoValue);
@@ -1141,9 +359,25 @@ void vtkVolumeCutRayCaster::SetSegmentAppearance(int label, const double color[3
 }
 
 //------------------------------------------------------------------------------
+void vtkVolumeCutRayCaster::SetSegmentSurfaceColor(int label, const double color[3])
+{
+  if (label < 1 || label >= static_cast<int>(this->Impl->Scene.Styles.size()) || !this->Impl->Scene.Styles[label].Defined || !color)
+  {
+    vtkErrorMacro("SetSegmentSurfaceColor: segment " << label << " has no appearance; call SetSegmentAppearance first");
+    return;
+  }
+  SegmentStyle& style = this->Impl->Scene.Styles[label];
+  for (int c = 0; c < 3; ++c)
+  {
+    style.SurfaceColor[c] = static_cast<float>(std::min(1.0, std::max(0.0, color[c])));
+  }
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
 void vtkVolumeCutRayCaster::RemoveAllSegmentAppearances()
 {
-  this->Impl->Styles.assign(2, SegmentStyle());
+  this->Impl->Scene.Styles.assign(2, SegmentStyle());
   this->Impl->DefaultStyles = true;
   this->Modified();
 }
@@ -1152,7 +386,7 @@ void vtkVolumeCutRayCaster::RemoveAllSegmentAppearances()
 int vtkVolumeCutRayCaster::GetNumberOfSegmentAppearances() const
 {
   return static_cast<int>(
-    std::count_if(this->Impl->Styles.begin(), this->Impl->Styles.end(), [](const SegmentStyle& style) { return style.Defined; }));
+    std::count_if(this->Impl->Scene.Styles.begin(), this->Impl->Scene.Styles.end(), [](const SegmentStyle& style) { return style.Defined; }));
 }
 
 //------------------------------------------------------------------------------
@@ -1226,6 +460,10 @@ const int* vtkVolumeCutRayCaster::GetSourceBuffer() const
 {
   return this->Impl->Source.empty() ? nullptr : this->Impl->Source.data();
 }
+const int* vtkVolumeCutRayCaster::GetSegmentBuffer() const
+{
+  return this->Impl->Segment.empty() ? nullptr : this->Impl->Segment.data();
+}
 
 namespace
 {
@@ -1261,6 +499,10 @@ void vtkVolumeCutRayCaster::GetNormalImage(vtkImageData* image) const
 void vtkVolumeCutRayCaster::GetSourceImage(vtkImageData* image) const
 {
   FillImage<vtkIntArray>(image, this->Impl->Width, this->Impl->Height, 1, this->Impl->Source);
+}
+void vtkVolumeCutRayCaster::GetSegmentImage(vtkImageData* image) const
+{
+  FillImage<vtkIntArray>(image, this->Impl->Width, this->Impl->Height, 1, this->Impl->Segment);
 }
 
 namespace
@@ -1324,29 +566,29 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     }
     vtkNew<vtkMatrix4x4> worldToIJK;
     vtkMatrix4x4::Invert(ijkToWorld, worldToIJK);
-    std::copy(&ijkToWorld->Element[0][0], &ijkToWorld->Element[0][0] + 16, impl.IJKToWorld);
-    std::copy(&worldToIJK->Element[0][0], &worldToIJK->Element[0][0] + 16, impl.WorldToIJK);
+    std::copy(&ijkToWorld->Element[0][0], &ijkToWorld->Element[0][0] + 16, impl.Scene.IJKToWorld);
+    std::copy(&worldToIJK->Element[0][0], &worldToIJK->Element[0][0] + 16, impl.Scene.WorldToIJK);
     // Normals: the transpose of world-to-IJK's linear part maps IJK gradients to world.
-    std::fill(impl.NormalMatrix4Storage, impl.NormalMatrix4Storage + 16, 0.0);
+    std::fill(impl.Scene.NormalMatrix, impl.Scene.NormalMatrix + 16, 0.0);
     for (int row = 0; row < 3; ++row)
     {
       for (int column = 0; column < 3; ++column)
       {
-        impl.NormalMatrix4Storage[4 * row + column] = worldToIJK->GetElement(column, row);
+        impl.Scene.NormalMatrix[4 * row + column] = worldToIJK->GetElement(column, row);
       }
     }
-    impl.NormalMatrix4Storage[15] = 1.0;
+    impl.Scene.NormalMatrix[15] = 1.0;
     const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
-    impl.Values.resize(count);
+    impl.Scene.Values.resize(count);
     const int stride = scalars->GetNumberOfComponents();
     switch (scalars->GetDataType())
     {
-      vtkTemplateMacro(CopyFirstComponent(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), stride, count, impl.Values.data()));
+      vtkTemplateMacro(CopyFirstComponent(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), stride, count, impl.Scene.Values.data()));
       default:
         vtkErrorMacro("Render: unsupported anatomy scalar type");
         return false;
     }
-    std::copy(dims, dims + 3, impl.Dimensions);
+    std::copy(dims, dims + 3, impl.Scene.Dimensions);
     impl.AnatomyCopyTime = std::max({ anatomy->GetMTime(), scalars->GetMTime(), impl.AnatomyMatrix ? impl.AnatomyMatrix->GetMTime() : 0 });
     impl.LabelCopyTime = 0;
     impl.BlockTime = 0;
@@ -1360,9 +602,9 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   vtkImageData* labelMap = impl.LabelMap;
   if (!labelMap)
   {
-    if (!impl.Labels.empty())
+    if (!impl.Scene.Labels.empty())
     {
-      impl.Labels.clear();
+      impl.Scene.Labels.clear();
       ++impl.LabelVersion;
       sceneChanged = true;
       impl.BlockTime = 0;
@@ -1375,18 +617,18 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     if (!labelScalars || !SameGeometry(labelMap, anatomy))
     {
       vtkErrorMacro("Render: the label map must have the anatomy's dimensions; rendering without labels");
-      impl.Labels.clear();
+      impl.Scene.Labels.clear();
     }
     else
     {
       const vtkIdType count = labelScalars->GetNumberOfTuples();
-      impl.Labels.resize(count);
+      impl.Scene.Labels.resize(count);
       bool outOfRange = false;
       for (vtkIdType n = 0; n < count; ++n)
       {
         const double label = labelScalars->GetComponent(n, 0);
         outOfRange |= !(label >= 0.0 && label <= 65535.0);
-        impl.Labels[n] = static_cast<uint16_t>(std::min(65535.0, std::max(0.0, std::isfinite(label) ? label : 0.0)));
+        impl.Scene.Labels[n] = static_cast<uint16_t>(std::min(65535.0, std::max(0.0, std::isfinite(label) ? label : 0.0)));
       }
       if (outOfRange)
       {
@@ -1407,9 +649,11 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     fractionTime = std::max({ fractionTime, image->GetMTime(),
       image->GetPointData()->GetScalars() ? image->GetPointData()->GetScalars()->GetMTime() : vtkMTimeType(0) });
   }
-  if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.Fractions.size() || sceneChanged)
+  if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.CopiedFractionInputs || sceneChanged)
   {
-    impl.Fractions.clear();
+    impl.Scene.Fractions.clear();
+    impl.SmoothedLabels.clear();
+    impl.CopiedFractionInputs = impl.FractionInputs.size();
     for (const auto& entry : impl.FractionInputs)
     {
       vtkImageData* image = entry.second.Image;
@@ -1419,7 +663,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
         vtkErrorMacro("Render: the fractional labelmap of segment " << entry.first << " must have the anatomy's dimensions; it is not shown");
         continue;
       }
-      Internals::FractionVolume fraction;
+      vtkVolumeCutRayScene::FractionVolume fraction;
       fraction.Label = entry.first;
       fraction.Values.resize(values->GetNumberOfTuples());
       const double v0 = entry.second.ValueAtZero;
@@ -1429,8 +673,9 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
         const double f = (values->GetComponent(n, 0) - v0) * scale;
         fraction.Values[n] = std::isfinite(f) ? static_cast<float>(std::min(1.0, std::max(0.0, f))) : 0.f;
       }
-      impl.Fractions.push_back(std::move(fraction));
+      impl.Scene.Fractions.push_back(std::move(fraction));
     }
+    impl.GivenFractions = impl.Scene.Fractions.size();
     impl.FractionCopyTime = std::max(fractionTime, vtkMTimeType(1));
     ++impl.LabelVersion;
     impl.BlockTime = 0;
@@ -1440,17 +685,52 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   // Segment 1 follows IsoValue until appearances are given.
   if (impl.DefaultStyles)
   {
-    SegmentStyle& bone = impl.Styles[1];
-    bone.Color[0] = 0.95f;
-    bone.Color[1] = 0.92f;
-    bone.Color[2] = 0.84f;
+    SegmentStyle& bone = impl.Scene.Styles[1];
+    bone.Color[0] = bone.SurfaceColor[0] = 0.95f;
+    bone.Color[1] = bone.SurfaceColor[1] = 0.92f;
+    bone.Color[2] = bone.SurfaceColor[2] = 0.84f;
     bone.Opacity = 1.f;
     bone.Iso = static_cast<float>(this->IsoValue);
     bone.Shape = false;
   }
-  if (impl.Styles.size() < 2)
+  if (impl.Scene.Styles.size() < 2)
   {
-    impl.Styles.resize(2);
+    impl.Scene.Styles.resize(2);
+  }
+
+  // Segments drawn by their shape from the label map alone: fractions from
+  // their smoothed indicator, after the given ones, made again when the
+  // labels, those segments or the smoothing change.
+  std::vector<int> smoothed;
+  if (this->LabelSmoothing > 0.0 && !impl.Scene.Labels.empty())
+  {
+    for (size_t label = 1; label < impl.Scene.Styles.size(); ++label)
+    {
+      const SegmentStyle& style = impl.Scene.Styles[label];
+      if (style.Defined && style.Shape && style.Opacity > 0.f && !impl.FractionInputs.count(static_cast<int>(label)) &&
+        impl.FractionInputs.size() + smoothed.size() < static_cast<size_t>(MaximumFractions))
+      {
+        smoothed.push_back(static_cast<int>(label));
+      }
+    }
+  }
+  if (smoothed != impl.SmoothedLabels || (!smoothed.empty() && (impl.SmoothedSigma != this->LabelSmoothing || impl.SmoothedLabelVersion != impl.LabelVersion)))
+  {
+    impl.Scene.Fractions.resize(impl.GivenFractions);
+    double spacing[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double column[3] = { impl.Scene.IJKToWorld[axis], impl.Scene.IJKToWorld[4 + axis], impl.Scene.IJKToWorld[8 + axis] };
+      spacing[axis] = vtkMath::Norm(column);
+    }
+    vtkVolumeCutLabelSmoothing::Smooth(impl.Scene.Labels, impl.Scene.Dimensions, spacing, smoothed, this->LabelSmoothing,
+      this->MaximumNumberOfThreads, impl.Scene.Fractions);
+    impl.SmoothedLabels = smoothed;
+    impl.SmoothedSigma = this->LabelSmoothing;
+    ++impl.LabelVersion;
+    impl.SmoothedLabelVersion = impl.LabelVersion;
+    impl.BlockTime = 0;
+    sceneChanged = true;
   }
 
   // Transfer functions (composite mode).
@@ -1465,23 +745,23 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     impl.OpacityFunction->GetRange(range);
     double colorRange[2];
     impl.ColorFunction->GetRange(colorRange);
-    impl.TableRange[0] = std::min(range[0], colorRange[0]);
-    impl.TableRange[1] = std::max(range[1], colorRange[1]);
-    impl.ColorTable.resize(3 * TransferTableSize);
-    impl.OpacityTable.resize(TransferTableSize);
-    impl.ColorFunction->GetTable(impl.TableRange[0], impl.TableRange[1], TransferTableSize, impl.ColorTable.data());
-    impl.OpacityFunction->GetTable(impl.TableRange[0], impl.TableRange[1], TransferTableSize, impl.OpacityTable.data());
+    impl.Scene.TableRange[0] = std::min(range[0], colorRange[0]);
+    impl.Scene.TableRange[1] = std::max(range[1], colorRange[1]);
+    impl.Scene.ColorTable.resize(3 * TransferTableSize);
+    impl.Scene.OpacityTable.resize(TransferTableSize);
+    impl.ColorFunction->GetTable(impl.Scene.TableRange[0], impl.Scene.TableRange[1], TransferTableSize, impl.Scene.ColorTable.data());
+    impl.OpacityFunction->GetTable(impl.Scene.TableRange[0], impl.Scene.TableRange[1], TransferTableSize, impl.Scene.OpacityTable.data());
   }
 
-  impl.AnyIsoSegment = false;
-  impl.MinimumIso = std::numeric_limits<double>::infinity();
-  for (size_t label = 1; label < impl.Styles.size(); ++label)
+  impl.Scene.AnyIsoSegment = false;
+  impl.Scene.MinimumIso = std::numeric_limits<double>::infinity();
+  for (size_t label = 1; label < impl.Scene.Styles.size(); ++label)
   {
-    const SegmentStyle& style = impl.Styles[label];
-    if (style.Opacity > 0.f && !style.Shape && (label == 1 || impl.HasSegments()))
+    const SegmentStyle& style = impl.Scene.Styles[label];
+    if (style.Opacity > 0.f && !style.Shape && (label == 1 || impl.Scene.HasSegments()))
     {
-      impl.AnyIsoSegment = true;
-      impl.MinimumIso = std::min(impl.MinimumIso, double(style.Iso));
+      impl.Scene.AnyIsoSegment = true;
+      impl.Scene.MinimumIso = std::min(impl.Scene.MinimumIso, double(style.Iso));
     }
   }
 
@@ -1503,137 +783,29 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   sceneChanged |= sceneTime != impl.SceneTime;
   impl.SceneTime = sceneTime;
 
+  impl.Scene.BlendMode = this->BlendMode;
+  impl.Scene.SampleDistance = this->SampleDistance;
+  impl.Scene.GradientStep = this->GradientStep;
+  impl.Scene.UnitDistance = this->ScalarOpacityUnitDistance;
+  impl.Scene.ThinBone = this->ThinBoneShading;
+  impl.Scene.ThinBoneThickness = this->ThinBoneThickness;
+  impl.Scene.AmbientOcclusion = this->AmbientOcclusion && !this->DraftQuality && this->BlendMode == IsoSurfaceBlend;
+  impl.Scene.AmbientOcclusionRadius = this->AmbientOcclusionRadius;
+  impl.Scene.Ambient = this->Ambient;
+  impl.Scene.Diffuse = this->Diffuse;
+  impl.Scene.Specular = this->Specular;
+  impl.Scene.SpecularPower = this->SpecularPower;
+
   // Empty-space blocks.
   if (impl.BlockTime == 0 || sceneChanged)
   {
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      impl.BlockDimensions[axis] = (dims[axis] - 1 + BlockSize - 1) / BlockSize;
-    }
-    const vtkIdType blockCount = static_cast<vtkIdType>(impl.BlockDimensions[0]) * impl.BlockDimensions[1] * impl.BlockDimensions[2];
-    impl.BlockOccupied.assign(blockCount, 0);
-    impl.BlockLipschitz.assign(blockCount, 0.f);
-    const bool composite = this->BlendMode == CompositeBlend;
-    ParallelFor(this->MaximumNumberOfThreads, impl.BlockDimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
-      for (vtkIdType bz = beginZ; bz < endZ; ++bz)
-      {
-        for (int by = 0; by < impl.BlockDimensions[1]; ++by)
-        {
-          for (int bx = 0; bx < impl.BlockDimensions[0]; ++bx)
-          {
-            const vtkIdType block = bx + impl.BlockDimensions[0] * (by + static_cast<vtkIdType>(impl.BlockDimensions[1]) * bz);
-            float lo = std::numeric_limits<float>::infinity();
-            float hi = -std::numeric_limits<float>::infinity();
-            bool occupied = false;
-            float slope[3] = { 0.f, 0.f, 0.f };
-            // Cells of the block and their far corners (one voxel of apron).
-            for (int k = int(bz) * BlockSize; k <= std::min((int(bz) + 1) * BlockSize, dims[2] - 1); ++k)
-            {
-              for (int j = by * BlockSize; j <= std::min((by + 1) * BlockSize, dims[1] - 1); ++j)
-              {
-                const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
-                for (int i = bx * BlockSize; i <= std::min((bx + 1) * BlockSize, dims[0] - 1); ++i)
-                {
-                  const float v = impl.Values[row + i];
-                  lo = v < lo ? v : lo;
-                  hi = v > hi ? v : hi;
-                  // Largest change to a neighbour along each axis bounds the
-                  // trilinear gradient's components.
-                  if (i + 1 < dims[0])
-                  {
-                    slope[0] = std::max(slope[0], std::abs(impl.Values[row + i + 1] - v));
-                  }
-                  if (j + 1 < dims[1])
-                  {
-                    slope[1] = std::max(slope[1], std::abs(impl.Values[row + dims[0] + i] - v));
-                  }
-                  if (k + 1 < dims[2])
-                  {
-                    slope[2] = std::max(slope[2], std::abs(impl.Values[row + static_cast<vtkIdType>(dims[0]) * dims[1] + i] - v));
-                  }
-                }
-              }
-            }
-            // Labels: a visible segment whose surface could lie in the block.
-            if (!composite && !impl.Labels.empty())
-            {
-              for (int k = int(bz) * BlockSize; k <= std::min((int(bz) + 1) * BlockSize, dims[2] - 1) && !occupied; ++k)
-              {
-                for (int j = by * BlockSize; j <= std::min((by + 1) * BlockSize, dims[1] - 1) && !occupied; ++j)
-                {
-                  const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
-                  for (int i = bx * BlockSize; i <= std::min((bx + 1) * BlockSize, dims[0] - 1); ++i)
-                  {
-                    const int label = impl.Labels[row + i];
-                    if (label > 0 && label < static_cast<int>(impl.Styles.size()))
-                    {
-                      const SegmentStyle& style = impl.Styles[label];
-                      if (style.Opacity > 0.f && (style.Shape || hi >= style.Iso))
-                      {
-                        occupied = true;
-                        break;
-                      }
-                    }
-                  }
-                }
-              }
-            }
-            if (!composite && !occupied)
-            {
-              // Fractional segments: any voxel of the block partly inside a shown one.
-              for (const Internals::FractionVolume& fraction : impl.Fractions)
-              {
-                const SegmentStyle& style =
-                  fraction.Label < static_cast<int>(impl.Styles.size()) ? impl.Styles[fraction.Label] : impl.Styles[0];
-                if (occupied || style.Opacity <= 0.f || (!style.Shape && hi < style.Iso))
-                {
-                  continue;
-                }
-                for (int k = int(bz) * BlockSize; k <= std::min((int(bz) + 1) * BlockSize, dims[2] - 1) && !occupied; ++k)
-                {
-                  for (int j = by * BlockSize; j <= std::min((by + 1) * BlockSize, dims[1] - 1) && !occupied; ++j)
-                  {
-                    const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
-                    for (int i = bx * BlockSize; i <= std::min((bx + 1) * BlockSize, dims[0] - 1) && !occupied; ++i)
-                    {
-                      occupied = fraction.Values[row + i] > 0.f;
-                    }
-                  }
-                }
-              }
-            }
-            if (!composite && !impl.HasSegments())
-            {
-              occupied = impl.Styles[1].Opacity > 0.f && hi >= impl.Styles[1].Iso;
-            }
-            else if (composite)
-            {
-              // Any opacity over the block's value range.
-              const double span = impl.TableRange[1] - impl.TableRange[0];
-              const int first = span > 0.0
-                ? std::max(0, static_cast<int>(std::floor((lo - impl.TableRange[0]) / span * (TransferTableSize - 1))))
-                : 0;
-              const int last = span > 0.0
-                ? std::min(TransferTableSize - 1, static_cast<int>(std::ceil((hi - impl.TableRange[0]) / span * (TransferTableSize - 1))))
-                : TransferTableSize - 1;
-              for (int n = std::min(first, TransferTableSize - 1); n <= last && !occupied; ++n)
-              {
-                occupied = impl.OpacityTable[n] > 0.f;
-              }
-            }
-            impl.BlockOccupied[block] = occupied ? 1 : 0;
-            // NaN voxels make the bound infinite: such blocks are always refined.
-            const float lipschitz = std::sqrt(slope[0] * slope[0] + slope[1] * slope[1] + slope[2] * slope[2]);
-            impl.BlockLipschitz[block] = std::isfinite(lipschitz) ? lipschitz : std::numeric_limits<float>::infinity();
-          }
-        }
-      }
-    });
+    impl.Scene.EmptySpace.Build(impl.Scene, this->MaximumNumberOfThreads);
     impl.BlockTime = sceneTime;
   }
 
   // Cut fields: usable when initialised on the anatomy's grid.
   impl.ActiveCuts.clear();
+  impl.Scene.CutFields.clear();
   for (size_t n = 0; n < impl.Cuts.size(); ++n)
   {
     CutEntry& entry = impl.Cuts[n];
@@ -1655,7 +827,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       {
         double column[3];
         const double unit[3] = { axis == 0 ? 1.0 : 0.0, axis == 1 ? 1.0 : 0.0, axis == 2 ? 1.0 : 0.0 };
-        TransformVector(impl.IJKToWorld, unit, column);
+        TransformVector(impl.Scene.IJKToWorld, unit, column);
         tolerance = std::max(tolerance, 1e-4 * vtkMath::Norm(column));
       }
       for (int corner = 0; corner < 4 && usable; ++corner)
@@ -1670,7 +842,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
           anatomyIndex[axis] = (sub[axis] + 0.5) / factor - 0.5;
         }
         double viaAnatomy[3];
-        TransformPoint(impl.IJKToWorld, anatomyIndex, viaAnatomy);
+        TransformPoint(impl.Scene.IJKToWorld, anatomyIndex, viaAnatomy);
         for (int axis = 0; axis < 3; ++axis)
         {
           usable &= std::abs(viaField[axis] - viaAnatomy[axis]) <= tolerance;
@@ -1690,16 +862,17 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     if (usable && field->GetNumberOfAllocatedBricks() > 0)
     {
       impl.ActiveCuts.push_back(static_cast<int>(n));
+      impl.Scene.CutFields.push_back(field);
     }
   }
 
-  impl.PlaneEquations.clear();
+  impl.Scene.Planes.clear();
   if (impl.Planes)
   {
     impl.Planes->InitTraversal();
     while (vtkPlane* plane = impl.Planes->GetNextItem())
     {
-      Internals::PlaneEquation equation;
+      vtkVolumeCutRayScene::PlaneEquation equation;
       plane->GetNormal(equation.Normal);
       if (vtkMath::Normalize(equation.Normal) <= 0.0)
       {
@@ -1708,20 +881,10 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       double origin[3];
       plane->GetOrigin(origin);
       equation.Offset = -vtkMath::Dot(equation.Normal, origin);
-      impl.PlaneEquations.push_back(equation);
+      impl.Scene.Planes.push_back(equation);
     }
   }
 
-  impl.BlendMode = this->BlendMode;
-  impl.SampleDistance = this->SampleDistance;
-  impl.GradientStep = this->GradientStep;
-  impl.UnitDistance = this->ScalarOpacityUnitDistance;
-  impl.ThinBone = this->ThinBoneShading;
-  impl.ThinBoneThickness = this->ThinBoneThickness;
-  impl.Ambient = this->Ambient;
-  impl.Diffuse = this->Diffuse;
-  impl.Specular = this->Specular;
-  impl.SpecularPower = this->SpecularPower;
   if (sceneChanged)
   {
     ++impl.SceneVersion;
@@ -1741,43 +904,40 @@ bool vtkVolumeCutRayCaster::UpdateScene(SceneView& view)
   view.Version = impl.SceneVersion;
   view.AnatomyVersion = impl.AnatomyCopyTime;
   view.LabelVersion = impl.LabelVersion;
-  view.Values = impl.Values.data();
-  std::copy(impl.Dimensions, impl.Dimensions + 3, view.Dimensions);
-  std::copy(impl.IJKToWorld, impl.IJKToWorld + 16, view.IJKToWorld);
-  std::copy(impl.WorldToIJK, impl.WorldToIJK + 16, view.WorldToIJK);
-  std::copy(impl.NormalMatrix4Storage, impl.NormalMatrix4Storage + 16, view.NormalMatrix);
-  view.Labels = impl.Labels.empty() ? nullptr : impl.Labels.data();
+  view.Values = impl.Scene.Values.data();
+  std::copy(impl.Scene.Dimensions, impl.Scene.Dimensions + 3, view.Dimensions);
+  std::copy(impl.Scene.IJKToWorld, impl.Scene.IJKToWorld + 16, view.IJKToWorld);
+  std::copy(impl.Scene.WorldToIJK, impl.Scene.WorldToIJK + 16, view.WorldToIJK);
+  std::copy(impl.Scene.NormalMatrix, impl.Scene.NormalMatrix + 16, view.NormalMatrix);
+  view.Labels = impl.Scene.Labels.empty() ? nullptr : impl.Scene.Labels.data();
   view.Fractions.clear();
-  for (const Internals::FractionVolume& fraction : impl.Fractions)
+  for (const vtkVolumeCutRayScene::FractionVolume& fraction : impl.Scene.Fractions)
   {
     view.Fractions.emplace_back(fraction.Label, fraction.Values.data());
   }
   view.Styles.clear();
-  for (const SegmentStyle& style : impl.Styles)
+  for (const SegmentStyle& style : impl.Scene.Styles)
   {
-    view.Styles.push_back({ style.Color[0], style.Color[1], style.Color[2], style.Opacity, style.Iso, style.Shape ? 1.f : 0.f, 0.f, 0.f });
+    view.Styles.push_back({ style.Color[0], style.Color[1], style.Color[2], style.Opacity, style.Iso, style.Shape ? 1.f : 0.f, 0.f, 0.f,
+      style.SurfaceColor[0], style.SurfaceColor[1], style.SurfaceColor[2], 0.f });
   }
-  std::copy(impl.BlockDimensions, impl.BlockDimensions + 3, view.BlockDimensions);
-  view.BlockOccupied = impl.BlockOccupied.data();
-  view.BlockLipschitz = impl.BlockLipschitz.data();
-  view.AnyIsoSegment = impl.AnyIsoSegment;
-  view.MinimumIso = impl.MinimumIso;
-  view.CutFields.clear();
-  for (int index : impl.ActiveCuts)
-  {
-    view.CutFields.push_back(impl.Cuts[index].Field);
-  }
+  std::copy(impl.Scene.EmptySpace.GetDimensions(), impl.Scene.EmptySpace.GetDimensions() + 3, view.BlockDimensions);
+  view.BlockOccupied = impl.Scene.EmptySpace.GetOccupied();
+  view.BlockLipschitz = impl.Scene.EmptySpace.GetGradientBounds();
+  view.AnyIsoSegment = impl.Scene.AnyIsoSegment;
+  view.MinimumIso = impl.Scene.MinimumIso;
+  view.CutFields = impl.Scene.CutFields;
   view.Planes.clear();
-  for (const Internals::PlaneEquation& plane : impl.PlaneEquations)
+  for (const vtkVolumeCutRayScene::PlaneEquation& plane : impl.Scene.Planes)
   {
     view.Planes.push_back({ plane.Normal[0], plane.Normal[1], plane.Normal[2], plane.Offset });
   }
-  view.ColorTable = impl.ColorTable.empty() ? nullptr : impl.ColorTable.data();
-  view.OpacityTable = impl.OpacityTable.empty() ? nullptr : impl.OpacityTable.data();
+  view.ColorTable = impl.Scene.ColorTable.empty() ? nullptr : impl.Scene.ColorTable.data();
+  view.OpacityTable = impl.Scene.OpacityTable.empty() ? nullptr : impl.Scene.OpacityTable.data();
   view.TableSize = TransferTableSize;
-  view.TableRange[0] = impl.TableRange[0];
-  view.TableRange[1] = impl.TableRange[1];
-  view.MaximumRefinements = MaximumRefinements;
+  view.TableRange[0] = impl.Scene.TableRange[0];
+  view.TableRange[1] = impl.Scene.TableRange[1];
+  view.MaximumRefinements = vtkVolumeCutBorderLocator::MaximumRefinements;
   return true;
 }
 
@@ -1817,7 +977,9 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     sameOpaque = impl.OpaqueDepth.size() == static_cast<size_t>(pixels) &&
       std::memcmp(opaqueDepth, impl.OpaqueDepth.data(), pixels * sizeof(float)) == 0;
   }
-  const bool localized = impl.ImageValid && sameCamera && sameOpaque && !sceneChanged;
+  const bool sameQuality = this->DraftQuality == impl.LastDraftQuality;
+  impl.LastDraftQuality = this->DraftQuality;
+  const bool localized = impl.ImageValid && sameCamera && sameOpaque && sameQuality && !sceneChanged;
 
   std::copy(matrix, matrix + 16, impl.WorldToNDC);
   vtkNew<vtkMatrix4x4> inverse;
@@ -1836,6 +998,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     impl.Depth.assign(pixels, 1.f);
     impl.Normal.assign(3 * pixels, 0.f);
     impl.Source.assign(pixels, SourceNone);
+    impl.Segment.assign(pixels, 0);
   }
 
   // Which pixels to cast: all, or those covering bricks changed since the last image.
@@ -1847,67 +1010,13 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     this->UpdatedRegion[1] = height;
     this->UpdatedRegion[2] = -1;
     this->UpdatedRegion[3] = -1;
-    vtkNew<vtkIdList> bricks;
     for (int index : impl.ActiveCuts)
     {
-      CutEntry& entry = impl.Cuts[index];
-      entry.Field->GetBricksModifiedSince(entry.RenderedStamp, bricks);
-      const int* brickDims = entry.Field->GetBrickDimensions();
-      vtkNew<vtkMatrix4x4> subToWorld;
-      entry.Field->GetSubVoxelIJKToRAS(subToWorld);
-      for (vtkIdType n = 0; n < bricks->GetNumberOfIds(); ++n)
-      {
-        const vtkIdType id = bricks->GetId(n);
-        const int b[3] = { static_cast<int>(id % brickDims[0]), static_cast<int>((id / brickDims[0]) % brickDims[1]),
-          static_cast<int>(id / (static_cast<vtkIdType>(brickDims[0]) * brickDims[1])) };
-        // A brick's samples reach two sub-voxels beyond it (interpolation and
-        // its curvature correction).
-        double lo[2] = { 1e300, 1e300 };
-        double hi[2] = { -1e300, -1e300 };
-        bool behind = false;
-        for (int corner = 0; corner < 8; ++corner)
-        {
-          double sub[4] = { b[0] * 8.0 + ((corner & 1) ? 10.0 : -3.0), b[1] * 8.0 + ((corner & 2) ? 10.0 : -3.0),
-            b[2] * 8.0 + ((corner & 4) ? 10.0 : -3.0), 1.0 };
-          double world[4];
-          subToWorld->MultiplyPoint(sub, world);
-          double clip[4];
-          Multiply4(matrix, world, clip);
-          if (clip[3] <= 1e-12)
-          {
-            behind = true;
-            break;
-          }
-          for (int axis = 0; axis < 2; ++axis)
-          {
-            const double ndc = clip[axis] / clip[3];
-            const double pixel = (ndc + 1.0) * 0.5 * (axis == 0 ? width : height);
-            lo[axis] = std::min(lo[axis], pixel);
-            hi[axis] = std::max(hi[axis], pixel);
-          }
-        }
-        if (behind)
-        {
-          lo[0] = lo[1] = 0.0;
-          hi[0] = width;
-          hi[1] = height;
-        }
-        const int x0 = std::max(0, static_cast<int>(std::floor(lo[0])) - 1);
-        const int x1 = std::min(width - 1, static_cast<int>(std::ceil(hi[0])) + 1);
-        const int y0 = std::max(0, static_cast<int>(std::floor(lo[1])) - 1);
-        const int y1 = std::min(height - 1, static_cast<int>(std::ceil(hi[1])) + 1);
-        for (int y = y0; y <= y1; ++y)
-        {
-          std::fill(mask.begin() + static_cast<vtkIdType>(y) * width + x0, mask.begin() + static_cast<vtkIdType>(y) * width + x1 + 1, 1);
-        }
-        if (x0 <= x1 && y0 <= y1)
-        {
-          this->UpdatedRegion[0] = std::min(this->UpdatedRegion[0], x0);
-          this->UpdatedRegion[1] = std::min(this->UpdatedRegion[1], y0);
-          this->UpdatedRegion[2] = std::max(this->UpdatedRegion[2], x1);
-          this->UpdatedRegion[3] = std::max(this->UpdatedRegion[3], y1);
-        }
-      }
+      const CutEntry& entry = impl.Cuts[index];
+      const double reach = std::max(impl.Scene.AmbientOcclusion ? impl.Scene.AmbientOcclusionRadius : 0.0,
+        impl.Scene.ThinBone ? impl.Scene.ThinBoneThickness : 0.0);
+      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(
+        entry.Field, entry.RenderedStamp, reach, matrix, width, height, mask, this->UpdatedRegion);
     }
   }
   for (size_t n = 0; n < impl.Cuts.size(); ++n)
@@ -1922,7 +1031,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   {
     // Ray length to the opaque geometry in each pixel.
     limits.resize(pixels);
-    ParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
+    vtkVolumeCutParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
       for (vtkIdType y = begin; y < end; ++y)
       {
         for (int x = 0; x < width; ++x)
@@ -1958,7 +1067,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   }
 
   std::atomic<vtkIdType> cast(0);
-  ParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
+  vtkVolumeCutParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
     vtkIdType local = 0;
     for (vtkIdType y = begin; y < end; ++y)
     {

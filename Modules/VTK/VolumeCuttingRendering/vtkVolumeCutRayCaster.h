@@ -111,6 +111,17 @@ public:
    */
   void SetSegmentAppearance(int label, const double color[3], double opacity, double isoValue);
   void RemoveAllSegmentAppearances();
+  ///@}
+
+  /**
+   * Colour of the segment's own surface where it is not cut (its appearance's
+   * colour until set; SetSegmentAppearance resets it). Cut and clip surfaces
+   * keep the appearance's colour: segments of one material (cortical and
+   * trabecular bone) look like one bone outside, and a cut shows which of
+   * them it exposes. The segment needs an appearance first (else an error).
+   */
+  void SetSegmentSurfaceColor(int label, const double color[3]);
+  ///@{
   int GetNumberOfSegmentAppearances() const;
   ///@}
 
@@ -163,6 +174,49 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Smoothing of segments drawn by their own shape from the label map
+   * alone (no fractional labelmap), as Slicer smooths the closed surfaces it
+   * makes of binary labelmaps: above 0, such a segment is drawn from a
+   * fraction made by shape-based interpolation between slices (each slice's
+   * signed distance to its outline, smoothed in the slice by a Gaussian of
+   * this standard deviation in voxels), without the voxels' stairs and the
+   * slices' terraces. Such segments count against the 16 fractional
+   * labelmaps (4 on the GPU). 0 (the default) draws the label map's
+   * trilinear indicator.
+   */
+  vtkSetClampMacro(LabelSmoothing, double, 0.0, 8.0);
+  vtkGetMacro(LabelSmoothing, double);
+  ///@}
+
+  ///@{
+  /**
+   * Ambient occlusion, a depth cue that makes cavities read in a still
+   * image: each surface point is darkened by the share of 14 points around
+   * it, up to AmbientOcclusionRadius (mm) away over its normal's
+   * hemisphere, that lie in visible material (cuts removed). Off by default;
+   * radius 6 mm.
+   */
+  vtkSetMacro(AmbientOcclusion, bool);
+  vtkGetMacro(AmbientOcclusion, bool);
+  vtkBooleanMacro(AmbientOcclusion, bool);
+  vtkSetClampMacro(AmbientOcclusionRadius, double, 0.1, 100.0);
+  vtkGetMacro(AmbientOcclusionRadius, double);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get whether renders leave ambient occlusion out although it is on:
+   * the mapper's frames drawn while the view moves. Unlike
+   * SetAmbientOcclusion it does not modify the caster, so that the
+   * empty-space structure is kept; the next render after a change recasts
+   * the whole image. Default is false.
+   */
+  void SetDraftQuality(bool draft) { this->DraftQuality = draft; }
+  bool GetDraftQuality() const { return this->DraftQuality; }
+  ///@}
+
+  ///@{
   /** Phong lighting with a headlight. */
   vtkSetMacro(Ambient, double);
   vtkGetMacro(Ambient, double);
@@ -202,18 +256,21 @@ public:
   /**
    * Results of the last Render (width x height, row 0 at the bottom):
    * premultiplied RGBA (4 floats a pixel), window depth of the first visible
-   * surface (1 where none), its world normal (3 floats, 0 where none), and
-   * which border it is: SourceNone, SourceObject, SourceVolumeBox,
-   * SourceClipPlane or SourceCutField + the cut field's index.
+   * surface (1 where none), its world normal (3 floats, 0 where none),
+   * which border it is (SourceNone, SourceObject, SourceVolumeBox,
+   * SourceClipPlane or SourceCutField + the cut field's index) and which
+   * segment's material it shows (its label; 0 where none and in composite mode).
    */
   const float* GetColorBuffer() const;
   const float* GetDepthBuffer() const;
   const float* GetNormalBuffer() const;
   const int* GetSourceBuffer() const;
+  const int* GetSegmentBuffer() const;
   void GetColorImage(vtkImageData* image) const;
   void GetDepthImage(vtkImageData* image) const;
   void GetNormalImage(vtkImageData* image) const;
   void GetSourceImage(vtkImageData* image) const;
+  void GetSegmentImage(vtkImageData* image) const;
   ///@}
 
   enum SurfaceSources
@@ -257,8 +314,9 @@ public:
     const unsigned short* Labels = nullptr;
     /// Fractional labelmaps: (label, fractions 0..1 on the anatomy's grid).
     std::vector<std::pair<int, const float*>> Fractions;
-    /// Per label: r, g, b, opacity, iso-value, shape flag, 0, 0.
-    std::vector<std::array<float, 8>> Styles;
+    /// Per label: r, g, b, opacity, iso-value, shape flag, 0, 0, and the
+    /// uncut surface's r, g, b, 0.
+    std::vector<std::array<float, 12>> Styles;
     int BlockDimensions[3] = { 0, 0, 0 };
     const unsigned char* BlockOccupied = nullptr;
     const float* BlockLipschitz = nullptr;
@@ -290,6 +348,10 @@ protected:
   double Diffuse = 0.7;
   double Specular = 0.15;
   double SpecularPower = 30.0;
+  double LabelSmoothing = 0.0;
+  bool AmbientOcclusion = false;
+  double AmbientOcclusionRadius = 6.0;
+  bool DraftQuality = false;
   int MaximumNumberOfThreads = 0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;

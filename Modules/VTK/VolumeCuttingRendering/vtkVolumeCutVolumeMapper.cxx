@@ -19,6 +19,7 @@
 #include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
 #include <vtkPiecewiseFunction.h>
+#include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkShaderProgram.h>
 #include <vtkSmartPointer.h>
@@ -28,6 +29,8 @@
 #include <vtkVolumeProperty.h>
 #include <vtk_glad.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -41,15 +44,19 @@ const char* const ImageFragmentShader = R"GLSL(//VTK::System::Dec
 in vec2 texCoord;
 uniform sampler2D colorTexture;
 uniform sampler2D depthTexture;
+// The share of the image over the viewport (less than 1 where a reduced
+// image's last block reaches past the viewport's edge).
+uniform vec2 imageScale;
 void main()
 {
-  vec4 color = texture(colorTexture, texCoord);
+  vec2 position = texCoord * imageScale;
+  vec4 color = texture(colorTexture, position);
   if (color.a <= 0.0)
   {
     discard;
   }
   gl_FragData[0] = color;
-  gl_FragDepth = texture(depthTexture, texCoord).r;
+  gl_FragDepth = texture(depthTexture, position).r;
 }
 )GLSL";
 }
@@ -65,6 +72,9 @@ struct vtkVolumeCutVolumeMapper::Internals
   vtkColorTransferFunction* ColorFunction = nullptr;
   vtkPiecewiseFunction* OpacityFunction = nullptr;
   std::string FallbackReason;
+  // Measured cost of a CPU frame per ray cast (drawing included), 0 before
+  // the first: what an interactive frame's resolution is chosen from.
+  double SecondsPerRay = 0.0;
   int ReportedPath = 0;
   bool ReportedNoInput = false;
   vtkOpenGLRenderWindow* Context = nullptr;
@@ -266,9 +276,11 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
       }
     }
   }
+  int sampleDistance = 1;
   if (path == CPUPath)
   {
-    if (!caster->Render(worldToNDC, width, height, opaqueDepth.data()) || !this->DrawCPUImage(renderer, x0, y0, width, height))
+    sampleDistance = this->ChooseImageSampleDistance(renderer, width, height);
+    if (!this->RenderOnCPU(renderer, worldToNDC, width, height, opaqueDepth, sampleDistance))
     {
       return;
     }
@@ -283,11 +295,78 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
     impl.ReportedPath = path;
   }
   this->LastRenderPath = path;
+  this->LastImageSampleDistance = sampleDistance;
   this->LastFrameTime = vtkTimerLog::GetUniversalTime() - start;
+  if (path == CPUPath && caster->GetNumberOfRaysCast() > 0 && !caster->GetLastRenderWasLocalized())
+  {
+    impl.SecondsPerRay = this->LastFrameTime / static_cast<double>(caster->GetNumberOfRaysCast());
+  }
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumeCutVolumeMapper::DrawCPUImage(vtkRenderer* vtkNotUsed(renderer), int vtkNotUsed(x0), int vtkNotUsed(y0), int width, int height)
+int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, int width, int height)
+{
+  const double rate = renderer->GetRenderWindow()->GetDesiredUpdateRate();
+  if (this->MaximumImageSampleDistance <= 1 || rate < this->InteractiveUpdateRate)
+  {
+    return 1;
+  }
+  if (this->Impl->SecondsPerRay <= 0.0)
+  {
+    // No frame measured yet: the coarsest, so that the first motion responds.
+    return this->MaximumImageSampleDistance;
+  }
+  // Rays cost about the same each, so the distance goes with the square root
+  // of the full frame's time over the time allowed.
+  const double fullFrame = this->Impl->SecondsPerRay * width * height;
+  const int distance = static_cast<int>(std::ceil(std::sqrt(fullFrame * rate)));
+  return std::max(1, std::min(this->MaximumImageSampleDistance, distance));
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutVolumeMapper::RenderOnCPU(
+  vtkRenderer* vtkNotUsed(renderer), vtkMatrix4x4* worldToNDC, int width, int height, const std::vector<float>& opaqueDepth, int sampleDistance)
+{
+  vtkVolumeCutRayCaster* caster = this->Impl->RayCaster;
+  if (sampleDistance <= 1)
+  {
+    return caster->Render(worldToNDC, width, height, opaqueDepth.data()) && this->DrawCPUImage(width, height, false, 1.0, 1.0);
+  }
+  // One ray at the centre of each block of pixels; the opaque geometry's
+  // depth is read there too (NDC is independent of the image's size).
+  const int reducedWidth = (width + sampleDistance - 1) / sampleDistance;
+  const int reducedHeight = (height + sampleDistance - 1) / sampleDistance;
+  std::vector<float> reducedDepth(static_cast<size_t>(reducedWidth) * reducedHeight);
+  for (int y = 0; y < reducedHeight; ++y)
+  {
+    const int sourceY = std::min(height - 1, y * sampleDistance + sampleDistance / 2);
+    for (int x = 0; x < reducedWidth; ++x)
+    {
+      const int sourceX = std::min(width - 1, x * sampleDistance + sampleDistance / 2);
+      reducedDepth[static_cast<size_t>(y) * reducedWidth + x] = opaqueDepth[static_cast<size_t>(sourceY) * width + sourceX];
+    }
+  }
+  // The reduced grid covers a little more than the viewport where the size
+  // is not a multiple of the distance: scale NDC so that its pixels stay square.
+  vtkNew<vtkMatrix4x4> toReduced;
+  toReduced->SetElement(0, 0, static_cast<double>(width) / (reducedWidth * sampleDistance));
+  toReduced->SetElement(1, 1, static_cast<double>(height) / (reducedHeight * sampleDistance));
+  toReduced->SetElement(0, 3, toReduced->GetElement(0, 0) - 1.0);
+  toReduced->SetElement(1, 3, toReduced->GetElement(1, 1) - 1.0);
+  vtkNew<vtkMatrix4x4> reducedWorldToNDC;
+  vtkMatrix4x4::Multiply4x4(toReduced, worldToNDC, reducedWorldToNDC);
+  // Ambient occlusion costs more than the rest of a ray on real data (14
+  // more lookups a surface point) and reads only in a still image: moving
+  // frames go without it, as VTK's mappers lower quality while interacting.
+  caster->SetDraftQuality(true);
+  const bool cast = caster->Render(reducedWorldToNDC, reducedWidth, reducedHeight, reducedDepth.data());
+  caster->SetDraftQuality(false);
+  return cast &&
+    this->DrawCPUImage(reducedWidth, reducedHeight, true, toReduced->GetElement(0, 0), toReduced->GetElement(1, 1));
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutVolumeMapper::DrawCPUImage(int width, int height, bool magnified, double scaleX, double scaleY)
 {
   Internals& impl = *this->Impl;
   vtkOpenGLRenderWindow* window = impl.Context;
@@ -341,11 +420,16 @@ bool vtkVolumeCutVolumeMapper::DrawCPUImage(vtkRenderer* vtkNotUsed(renderer), i
     vtkErrorMacro("Render: the image shader does not compile on this OpenGL context");
     return false;
   }
+  // A magnified image is filtered so that its blocks do not flicker while
+  // the camera moves; its depth stays that of one ray.
+  impl.Color->SetMagnificationFilter(magnified ? vtkTextureObject::Linear : vtkTextureObject::Nearest);
   window->GetShaderCache()->ReadyShaderProgram(impl.Quad->Program);
   impl.Color->Activate();
   impl.Depth->Activate();
   impl.Quad->Program->SetUniformi("colorTexture", impl.Color->GetTextureUnit());
   impl.Quad->Program->SetUniformi("depthTexture", impl.Depth->GetTextureUnit());
+  const float imageScale[2] = { static_cast<float>(scaleX), static_cast<float>(scaleY) };
+  impl.Quad->Program->SetUniform2f("imageScale", imageScale);
   vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(window, impl.Quad.get());
   impl.Color->Deactivate();
   impl.Depth->Deactivate();
@@ -360,6 +444,9 @@ void vtkVolumeCutVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LastRenderPath: " << this->GetLastRenderPathAsString() << "\n";
   os << indent << "GPUFallbackReason: " << this->Impl->FallbackReason << "\n";
   os << indent << "LastFrameTime: " << this->LastFrameTime << "\n";
+  os << indent << "InteractiveUpdateRate: " << this->InteractiveUpdateRate << "\n";
+  os << indent << "MaximumImageSampleDistance: " << this->MaximumImageSampleDistance << "\n";
+  os << indent << "LastImageSampleDistance: " << this->LastImageSampleDistance << "\n";
   os << indent << "RayCaster:\n";
   this->Impl->RayCaster->PrintSelf(os, indent.GetNextIndent());
 }

@@ -23,6 +23,19 @@
  * The mapper's clipping planes become clip surfaces. Stereo works as for any
  * mapper: the renderer draws each eye with its own camera.
  *
+ * Progressive refinement on the CPU path, by VTK's convention for
+ * interactive volume rendering (vtkSmartVolumeMapper, Slicer's volume
+ * rendering): a render is interactive while the render window's
+ * DesiredUpdateRate is at or above InteractiveUpdateRate (interactor
+ * styles and Slicer's camera widget raise it while the camera moves; the
+ * displayable manager raises it while a stroke is drawn). An interactive
+ * CPU frame casts one ray per ImageSampleDistance x ImageSampleDistance
+ * pixels, the distance chosen from the measured cost of a ray so that the
+ * frame fits in 1 / DesiredUpdateRate, without ambient occlusion; the
+ * image is magnified. The first
+ * still render (the rate lowered again when the motion stops) casts every
+ * pixel and is the same image as a render that never interacted.
+ *
  * @sa vtkVolumeCutRayCaster vtkVolumeCutOpenGLRayCaster vtkVolumeCutField
  */
 
@@ -33,6 +46,10 @@
 #include "vtkVolumeCuttingRenderingExport.h" // For export macro
 
 #include <memory> // For std::unique_ptr
+#include <vector> // For std::vector
+
+class vtkMatrix4x4;
+class vtkRenderer;
 
 class vtkVolumeCutOpenGLRayCaster;
 class vtkVolumeCutRayCaster;
@@ -76,6 +93,31 @@ public:
   /// Seconds the last frame took in this mapper (ray casting and drawing).
   vtkGetMacro(LastFrameTime, double);
 
+  ///@{
+  /**
+   * Set/get the render window's DesiredUpdateRate (frames per second) at or
+   * above which a render is interactive and the CPU path may cast fewer
+   * rays than pixels (as vtkSmartVolumeMapper). Default is 1.0.
+   */
+  vtkSetClampMacro(InteractiveUpdateRate, double, 1.0e-4, VTK_DOUBLE_MAX);
+  vtkGetMacro(InteractiveUpdateRate, double);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the largest image sample distance (pixels between rays, each
+   * way) of an interactive CPU frame: the floor of its resolution when the
+   * frame cannot fit in the time the window allows. 1 turns progressive
+   * refinement off. Default is 16 (a 1024 x 768 view drawn from 64 x 48
+   * rays where a full frame takes seconds).
+   */
+  vtkSetClampMacro(MaximumImageSampleDistance, int, 1, 64);
+  vtkGetMacro(MaximumImageSampleDistance, int);
+  ///@}
+
+  /// Pixels between rays (each way) in the last frame: 1 at full resolution.
+  vtkGetMacro(LastImageSampleDistance, int);
+
   void Render(vtkRenderer* renderer, vtkVolume* volume) override;
   void ReleaseGraphicsResources(vtkWindow* window) override;
 
@@ -85,11 +127,22 @@ protected:
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
 
-  bool DrawCPUImage(vtkRenderer* renderer, int x0, int y0, int width, int height);
+  /// Casts the rays on the CPU, one per sampleDistance^2 pixels, and draws the image.
+  bool RenderOnCPU(vtkRenderer* renderer, vtkMatrix4x4* worldToNDC, int width, int height, const std::vector<float>& opaqueDepth,
+    int sampleDistance);
+  /// Draws the CPU image over the viewport, filtered where it is magnified;
+  /// scale: the share of the image that covers it (below 1 where a reduced
+  /// image's last block reaches past the viewport's edge).
+  bool DrawCPUImage(int width, int height, bool magnified, double scaleX, double scaleY);
+  /// The image sample distance for this frame: 1 unless interactive.
+  int ChooseImageSampleDistance(vtkRenderer* renderer, int width, int height);
 
   int RequestedRenderPath = AutomaticPath;
   int LastRenderPath = 0;
   double LastFrameTime = 0.0;
+  double InteractiveUpdateRate = 1.0;
+  int MaximumImageSampleDistance = 16;
+  int LastImageSampleDistance = 1;
 
 private:
   vtkVolumeCutVolumeMapper(const vtkVolumeCutVolumeMapper&) = delete;

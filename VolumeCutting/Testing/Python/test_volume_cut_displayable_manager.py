@@ -101,10 +101,16 @@ def test_rendering_settings_are_saved_with_the_node(scene_xml_round_trip):
     node.SetSurfaceIsoValue(412.5)
     node.SetThinBoneShading(True)
     node.SetThinBoneThickness(1.75)
+    node.SetAmbientOcclusion(False)
+    node.SetLabelSmoothing(0.5)
+    node.SetMaterialSegmentIDs(["Cortex", "Cancellous;bone", "Cortex"])
     copy = scene_xml_round_trip(node)
     assert copy.GetSurfaceIsoValue() == pytest.approx(412.5)
     assert copy.GetThinBoneShading()
     assert copy.GetThinBoneThickness() == pytest.approx(1.75)
+    assert not copy.GetAmbientOcclusion()
+    assert copy.GetLabelSmoothing() == pytest.approx(0.5)
+    assert list(copy.GetMaterialSegmentIDs()) == ["Cortex", "Cancellous;bone"]
 
 
 def test_fractional_labelmap_segments_are_drawn_at_sub_voxel_accuracy(session):

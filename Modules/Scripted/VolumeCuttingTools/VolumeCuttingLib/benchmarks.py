@@ -494,6 +494,12 @@ def haptics(repeats: int) -> list[dict]:
     return hapticbenchmarks.haptics(repeats)
 
 
+def interactive(repeats: int) -> list[dict]:
+    from . import interactivebenchmarks
+
+    return interactivebenchmarks.interactive(repeats)
+
+
 def sliceview(repeats: int) -> list[dict]:
     from . import slicebenchmarks
 
@@ -524,6 +530,7 @@ AREAS = {
     "mapper": mapper,
     "workflow": workflow,
     "haptics": haptics,
+    "interactive": interactive,
     "sliceview": sliceview,
     "softcut": softcut,
     "webapp": webapp,

@@ -130,13 +130,13 @@ def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool, own_data
     cut_node.SetCuttableSegmentIDs(cuttable)
 
 
-def lateral_camera(view, segmentation_node, segment_ids):
-    """Look at the bone from the patient's right, the surgeon's view of a right mastoid."""
-    bounds = [0.0] * 6
-    segmentation_node.GetBounds(bounds)
-    center = [(bounds[2 * axis] + bounds[2 * axis + 1]) / 2.0 for axis in range(3)]
-    extent = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
-    view.look_at(center, direction=(1.0, 0.0, 0.0), distance=2.2 * extent, view_up=(0.0, 0.0, 1.0))
+def cavity_camera(view, plan):
+    """Look into the planned cavity along its approach, a view ten burr paths across, as a surgeon drilling sees it."""
+    into = np.asarray(plan.direction, dtype=float) / np.linalg.norm(plan.direction)
+    center = np.asarray(plan.entry, dtype=float) + 0.5 * plan.depth * into
+    view.renderer.GetActiveCamera().SetViewAngle(30.0)
+    height = 6.0 * plan.surface_radius
+    view.look_at(center, direction=-into, distance=0.5 * height / np.tan(np.radians(15.0)), view_up=(0.0, 0.0, 1.0))
 
 
 # The cutting burr matches the plan's; the last layers are polished with a 3 mm diamond burr.
@@ -171,6 +171,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     roles_segmentation = anatomy_segmentation if anatomy_segmentation is not None else bone
     cut_node = logic.AddVolumeCutNode(volume, roles_segmentation)
     assign_roles(cut_node, roles_segmentation, logic, use_phantom, own_data)
+    # Bone is one material outside; a cut shows whether it exposes cortex or cancellous bone.
+    bone_segments = PHANTOM_BONE_SEGMENTS if use_phantom else \
+        [logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()] if roles_segmentation is bone else []
+    cut_node.SetMaterialSegmentIDs(list(bone_segments))
     messages = slicer.vtkMRMLMessageCollection()
     inputs_ok = logic.CheckInputs(cut_node, messages)
 
@@ -205,7 +209,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     cut_node.SetThinBoneShading(True)
     cut_node.SetThinBoneThickness(1.0)
     view = application.create_3d_view(*size)
-    lateral_camera(view, bone, None)
+    cavity_camera(view, plan)
     with timer.measure("first_frame_s"):
         view.render()
     before_path = view.screenshot(out_dir / "cut_before.png")
@@ -273,15 +277,18 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     bounds = [0.0] * 6
     volume.GetRASBounds(bounds)
     lateral = 1.0 if entry[0] > (bounds[0] + bounds[1]) / 2.0 else -1.0
-    rim = entry + np.array([0.0, 0.0, 0.85 * plan.surface_radius])
-    # From outside the head, a little above, so the rim's edge shows against the cavity.
+    # The lower rim, from outside the head and a little above, so that its
+    # edge shows against the cavity's far wall (the bone above the upper rim
+    # bulges out and would hide it).
+    rim = entry - np.array([0.0, 0.0, 0.85 * plan.surface_radius])
     view.look_at(rim, direction=(lateral * 0.94, 0.0, 0.34), distance=45.0, view_up=(0.0, 0.0, 1.0))
     view.renderer.GetActiveCamera().SetViewAngle(12.0)
     view.renderer.ResetCameraClippingRange()
     cut_node.SetThinBoneShading(False)  # the edge itself, in the bone's colour
     view.render()
-    cut_node.SetThinBoneShading(True)
+    # Taken before thin-bone shading comes back: the node's change would draw the view again.
     zoom_path = view.screenshot(out_dir / "cut_edge_zoom.png")
+    cut_node.SetThinBoneShading(True)
     renderer = view.renderer_description()
 
     # A slice view across the cavity: the cut's outline and fill over the CT

@@ -158,6 +158,77 @@ int TestSmoothingAndDirection()
   return EXIT_SUCCESS;
 }
 
+// A bone ball as a CT scans it: a cortex (1500 HU) from 6 to 10 mm around
+// trabecular bone (450 HU), its outer boundary a partial-volume ramp down to
+// air over 2 mm, so the voxels the boundary crosses have trabecular-range
+// values. The paper's model (cortical boundary, trabecular interior) wants
+// them cortical. The interior, an air cell in its middle (2 mm), stays
+// trabecular: bone around air but away from the cortex is not its shell.
+int TestPartialVolumeShell()
+{
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(31, 31, 31);
+  image->AllocateScalars(VTK_SHORT, 1);
+  short* voxels = static_cast<short*>(image->GetScalarPointer());
+  const double center[3] = { 15.2, 14.9, 15.1 };
+  for (int k = 0; k < 31; ++k)
+  {
+    for (int j = 0; j < 31; ++j)
+    {
+      for (int i = 0; i < 31; ++i)
+      {
+        const double p[3] = { double(i), double(j), double(k) };
+        const double r = Distance(p, center);
+        const double value = r <= 2.0 ? -1000.0
+          : r <= 6.0                 ? 450.0
+          : r <= 10.0                ? 1500.0
+          : r >= 12.0                ? -1000.0
+                                     : 1500.0 - 2500.0 * (r - 10.0) / 2.0;
+        voxels[(k * 31 + j) * 31 + i] = static_cast<short>(value);
+      }
+    }
+  }
+  for (bool boundaryIsCortical : { false, true })
+  {
+    vtkNew<vtkImageBoneSegmentation> segmentation;
+    segmentation->SetInputData(image);
+    segmentation->SetBoundaryIsCortical(boundaryIsCortical);
+    segmentation->Update();
+    vtkImageData* labels = segmentation->GetOutput();
+    vtkIdType rampVoxels = 0;
+    vtkIdType rampCortical = 0;
+    vtkIdType counted[3] = { 0, 0, 0 };
+    for (int k = 0; k < 31; ++k)
+    {
+      for (int j = 0; j < 31; ++j)
+      {
+        for (int i = 0; i < 31; ++i)
+        {
+          const double p[3] = { double(i), double(j), double(k) };
+          const double r = Distance(p, center);
+          const int label = static_cast<int>(labels->GetScalarComponentAsDouble(i, j, k, 0));
+          ++counted[label];
+          if (r > 2.0 && r <= 5.0)
+          {
+            CHECK_INT(label, vtkImageBoneSegmentation::TrabecularLabel);
+          }
+          const short value = voxels[(k * 31 + j) * 31 + i];
+          if (r > 10.0 && value >= 200 && value < 700)
+          {
+            ++rampVoxels;
+            rampCortical += label == vtkImageBoneSegmentation::CorticalLabel;
+          }
+        }
+      }
+    }
+    CHECK_BOOL(rampVoxels > 200, true);
+    CHECK_INT(rampCortical, boundaryIsCortical ? rampVoxels : 0);
+    CHECK_INT(segmentation->GetNumberOfCorticalVoxels(), counted[vtkImageBoneSegmentation::CorticalLabel]);
+    CHECK_INT(segmentation->GetNumberOfTrabecularVoxels(), counted[vtkImageBoneSegmentation::TrabecularLabel]);
+  }
+  return EXIT_SUCCESS;
+}
+
 int TestBadInput()
 {
   vtkNew<vtkImageBoneSegmentation> segmentation;
@@ -203,11 +274,13 @@ int vtkImageBoneSegmentationTest1(int, char*[])
 {
   CHECK_EXIT_SUCCESS(TestAgainstAnalyticBall());
   CHECK_EXIT_SUCCESS(TestSmoothingAndDirection());
+  CHECK_EXIT_SUCCESS(TestPartialVolumeShell());
   CHECK_EXIT_SUCCESS(TestBadInput());
 
   vtkNew<vtkImageBoneSegmentation> segmentation;
   std::stringstream printed;
   segmentation->Print(printed);
   CHECK_BOOL(printed.str().find("CorticalThreshold: 700") != std::string::npos, true);
+  CHECK_BOOL(printed.str().find("BoundaryIsCortical: 1") != std::string::npos, true);
   return EXIT_SUCCESS;
 }

@@ -126,14 +126,15 @@ def add_cut_volume(scene, intensities, cut, renderer):
     return mapper, volume
 
 
-def read_window(window, width):
+def read_window(window, width, height=None):
+    height = height or width
     depth = vtk.vtkFloatArray()
-    window.GetZbufferData(0, 0, width - 1, width - 1, depth)
+    window.GetZbufferData(0, 0, width - 1, height - 1, depth)
     rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
+    window.GetRGBACharPixelData(0, 0, width - 1, height - 1, 1, rgba)
     return (
-        numpy_support.vtk_to_numpy(depth).reshape(width, width),
-        numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4).astype(int),
+        numpy_support.vtk_to_numpy(depth).reshape(height, width),
+        numpy_support.vtk_to_numpy(rgba).reshape(height, width, 4).astype(int),
     )
 
 
@@ -559,3 +560,305 @@ def test_a_lost_context_is_rebuilt_without_a_crash(scene, intensities, path):
     assert mapper.GetLastRenderPath() == getattr(vc.vtkVolumeCutVolumeMapper, path)
     assert np.any(before < 1.0)
     assert np.allclose(before, after, atol=1e-6)
+
+
+def partial_volume_ball(n=40, center=(19.6, 20.3, 19.8), radius=11.0, ramp=2.5):
+    """A bone ball as CT sees it (1500 HU, a linear ramp to -1000 HU over ``ramp`` voxels
+    outside ``radius``) and labels: 1 where the CT is at or above 300 HU, 2 on the ramp's
+    outer voxels (a halo of another segment around the bone, as segmentations have)."""
+    index = np.arange(n, dtype=float)
+    z, y, x = np.meshgrid(index - center[2], index - center[1], index - center[0], indexing="ij")
+    r = np.sqrt(x * x + y * y + z * z)
+    ct = np.clip(1500.0 - 2500.0 * (r - radius) / ramp, -1000.0, 1500.0).astype(np.float32)
+    labels = np.zeros(ct.shape, np.uint16)
+    labels[ct >= 300.0] = 1
+    labels[(ct < 300.0) & (ct > -900.0)] = 2
+
+    def image(values):
+        result = vtk.vtkImageData()
+        result.SetDimensions(n, n, n)
+        result.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.ravel(), deep=True))
+        return result
+
+    return image(ct), image(labels)
+
+
+def test_surface_shows_the_segment_of_the_material_behind_it():
+    """The 300 HU surface crosses voxels of the halo segment; it is coloured as the bone under it."""
+    ct, labels = partial_volume_ball()
+    width = 64
+    window, renderer = render_window(width)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(20.0, 20.0, 20.0)
+    camera.SetPosition(20.0, -60.0, 35.0)
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    renderer.SetActiveCamera(camera)
+    renderer.ResetCameraClippingRange()
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(ct)
+    caster = mapper.GetRayCaster()
+    caster.SetLabelMap(labels)
+    caster.SetSegmentAppearance(1, (0.9, 0.2, 0.2), 1.0, 300.0)
+    caster.SetSegmentAppearance(2, (0.2, 0.9, 0.2), 1.0, 300.0)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    renderer.AddVolume(volume)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    owners = image_array(caster.GetSegmentImage, width, width, 1)
+    surface = owners > 0
+    assert surface.sum() > 0.15 * width * width
+    assert np.all(owners[surface] == 1)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    covered = cpu_depth < 1.0
+    assert np.all(cpu_color[covered][:, 0] > cpu_color[covered][:, 1])  # red bone, no green halo
+    assert np.array_equal(covered, gpu_depth < 1.0)
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+
+
+def shell_and_core(scene):
+    """Labels of the cube: a 3-voxel shell (segment 1, cortex) around a core (segment 2, cancellous bone)."""
+    n = scene.dimensions
+    index = np.arange(n) - (n - 1) / 2.0
+    depth = scene.half_size_voxels - np.max(np.abs(np.stack(np.meshgrid(index, index, index, indexing="ij"))), axis=0)
+    labels = np.where(depth >= 3.0, 2, 1).astype(np.uint16)
+    image = vtk.vtkImageData()
+    image.SetDimensions(n, n, n)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(labels.ravel(), deep=True))
+    return image
+
+
+def test_segments_of_one_material_share_their_surface_colour_and_cuts_tell_them_apart(scene, intensities):
+    width = 64
+    cut = vc.vtkVolumeCutField()
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    top = scene.center + [0.0, 0.0, scene.half_size]
+    cut.CutCapsule(list(top), list(top), 5.0)  # a pit through the shell into the core
+    window, renderer = render_window(width)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*scene.center)
+    camera.SetPosition(*(scene.center + [25.0, -30.0, 60.0]))
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    renderer.SetActiveCamera(camera)
+    renderer.ResetCameraClippingRange()
+    mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
+    caster = mapper.GetRayCaster()
+    caster.SetLabelMap(shell_and_core(scene))
+    cortex, cancellous = (0.9, 0.9, 0.8), (0.8, 0.3, 0.2)
+    caster.SetSegmentAppearance(1, cortex, 1.0, scene.iso_value())
+    caster.SetSegmentAppearance(2, cancellous, 1.0, scene.iso_value())
+    caster.SetSegmentSurfaceColor(2, cortex)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    sources = image_array(caster.GetSourceImage, width, width, 1)
+    owners = image_array(caster.GetSegmentImage, width, width, 1)
+    rgba = image_array(caster.GetColorImage, width, width, 4)
+    outer = sources == vc.vtkVolumeCutRayCaster.SourceObject
+    exposed = sources == vc.vtkVolumeCutRayCaster.SourceCutField
+    assert outer.sum() > 500 and exposed.sum() > 50
+    # Uncut: one bone, whichever segment owns it; cut: each its own colour.
+    redness = rgba[..., 0] / np.maximum(rgba[..., 2], 1e-6)  # 1.1 for the cortex's colour, 4 for the core's
+    assert np.all(redness[outer] < 1.5)
+    assert np.any(exposed & (owners == 1)) and np.any(exposed & (owners == 2))
+    assert np.all(redness[exposed & (owners == 2)] > 2.0)
+    assert np.all(redness[exposed & (owners == 1)] < 1.5)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    # (a ray grazing the cube's far edge may end on either side of it)
+    assert np.mean(np.abs(cpu_depth - gpu_depth) > 1e-4) < 0.005
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+    log = ErrorLog(caster)
+    caster.SetSegmentSurfaceColor(9, cortex)  # no such segment
+    assert "has no appearance" in log.messages[-1]
+
+
+def test_ambient_occlusion_darkens_a_cavity_not_a_flat_face(scene, intensities):
+    width = 64
+    cut = vc.vtkVolumeCutField()
+    cut.Initialize([scene.dimensions] * 3, scene.ijk_to_ras(), 2)
+    top = scene.center + [0.0, 0.0, scene.half_size]
+    cut.CutCapsule(list(top), list(top), 4.0)
+    camera = vtk.vtkCamera()
+    camera.SetFocalPoint(*scene.center)
+    camera.SetPosition(*(scene.center + [0.0, 0.0, 100.0]))
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(50.0, 200.0)
+    matrix = A.world_to_ndc(camera, width, width)
+    images = {}
+    for occlusion in (False, True):
+        caster = vc.vtkVolumeCutRayCaster()
+        caster.SetAnatomy(intensities, scene.ijk_to_ras())
+        caster.SetIsoValue(scene.iso_value())
+        caster.AddCutField(cut)
+        caster.SetAmbientOcclusion(occlusion)
+        caster.SetAmbientOcclusionRadius(6.0)
+        assert caster.Render(matrix, width, width)
+        images[occlusion] = image_array(caster.GetColorImage, width, width, 4)
+    middle = width // 2
+    plain, occluded = images[False], images[True]
+    # The pit's floor is darker, the flat top away from the pit is not.
+    assert occluded[middle, middle, 0] < 0.8 * plain[middle, middle, 0]
+    assert occluded[middle + 20, middle + 20, 0] == pytest.approx(plain[middle + 20, middle + 20, 0], rel=1e-6)
+
+    # A stroke next to the pit: the localized update recasts the pixels whose
+    # occlusion looks into it, and equals a full render.
+    cut.CutCapsule(list(top + [8.0, 0.0, 0.0]), list(top + [8.5, 0.0, 0.0]), 1.0)
+    assert caster.Render(matrix, width, width)
+    assert caster.GetLastRenderWasLocalized()
+    fresh = vc.vtkVolumeCutRayCaster()
+    fresh.SetAnatomy(intensities, scene.ijk_to_ras())
+    fresh.SetIsoValue(scene.iso_value())
+    fresh.AddCutField(cut)
+    fresh.SetAmbientOcclusion(True)
+    fresh.SetAmbientOcclusionRadius(6.0)
+    assert fresh.Render(matrix, width, width)
+    assert np.array_equal(image_array(caster.GetColorImage, width, width, 4), image_array(fresh.GetColorImage, width, width, 4))
+
+
+def test_gpu_path_draws_ambient_occlusion_like_the_cpu(scene, intensities):
+    width = 48
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 1.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(2), renderer)
+    mapper.GetRayCaster().SetAmbientOcclusion(True)
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
+    gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
+    assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+    assert np.mean(np.max(np.abs(cpu_color - gpu_color), axis=2) > 2) < 0.005
+
+
+def test_binary_segments_are_smoothed_between_slices(scene, intensities):
+    """A ball stored as whole voxels on thick slices: smoothing brings its surface near the exact sphere, CPU and GPU alike."""
+    n, center, radius = 32, (15.3, 15.6, 15.2), 9.0
+    _, binary = sphere_segment(n, center, radius)
+    ct = vtk.vtkImageData()
+    ct.SetDimensions(n, n, n)
+    ct.AllocateScalars(vtk.VTK_FLOAT, 1)
+    ct.GetPointData().GetScalars().Fill(0.0)
+    ct.SetSpacing(0.7, 0.7, 2.5)
+    world_center = np.array(center) * [0.7, 0.7, 2.5]
+    ellipsoid_radii = radius * np.array([0.7, 0.7, 2.5])
+    camera = vtk.vtkCamera()
+    camera.ParallelProjectionOn()
+    camera.SetParallelScale(1.1 * ellipsoid_radii[2])
+    camera.SetFocalPoint(*world_center)
+    camera.SetPosition(*(world_center + [60.0, 0.0, 0.0]))
+    camera.SetViewUp(0.0, 0.0, 1.0)
+    camera.SetClippingRange(20.0, 100.0)
+    width = 64
+    errors = {}
+    for smoothing in (0.0, 1.0):
+        window, renderer = render_window(width)
+        renderer.SetActiveCamera(camera)
+        mapper = vc.vtkVolumeCutVolumeMapper()
+        mapper.SetInputData(ct)
+        caster = mapper.GetRayCaster()
+        caster.SetLabelMap(binary)
+        caster.SetSegmentAppearance(1, (0.9, 0.8, 0.2), 1.0, float("nan"))
+        caster.SetLabelSmoothing(smoothing)
+        volume = vtk.vtkVolume()
+        volume.SetMapper(mapper)
+        renderer.AddVolume(volume)
+        images = {}
+        for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+            mapper.SetRequestedRenderPath(path)
+            window.Render()
+            assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+            images[path] = read_window(window, width)
+        cpu_depth, gpu_depth = images[vc.vtkVolumeCutVolumeMapper.CPUPath][0], images[vc.vtkVolumeCutVolumeMapper.GPUPath][0]
+        assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
+        assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
+        matrix = A.world_to_ndc(camera, width, width)
+        points = A.depth_to_points(matrix, cpu_depth.astype(float))
+        # The ellipsoid the stretched ball is: its x at the rendered (y, z).
+        u = (points[..., 1] - world_center[1]) / ellipsoid_radii[1]
+        w = (points[..., 2] - world_center[2]) / ellipsoid_radii[2]
+        inner = (cpu_depth < 1.0) & (u * u + w * w < 0.6)
+        exact = world_center[0] + ellipsoid_radii[0] * np.sqrt(1.0 - u[inner] ** 2 - w[inner] ** 2)
+        errors[smoothing] = float(np.sqrt(np.mean((points[..., 0][inner] - exact) ** 2)))
+    assert errors[1.0] < 0.8 * errors[0.0]
+
+
+def test_interactive_frames_are_reduced_and_the_still_frame_is_the_full_image(scene, intensities):
+    width, height = 90, 70  # not multiples of the sample distance: the last block reaches past the edge
+    camera = A.make_camera(scene, 4.0, width, height)
+    cut = scene.cut_field(2)
+    # The image a view that never moved draws.
+    window, renderer = render_window(width, height)
+    renderer.SetActiveCamera(camera)
+    mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    # Moving frames leave ambient occlusion out; the refined one must not.
+    mapper.GetRayCaster().SetAmbientOcclusion(True)
+    window.Render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    full = read_window(window, width, height)
+
+    moving, moving_renderer = render_window(width, height)
+    moving_camera = vtk.vtkCamera()
+    moving_camera.DeepCopy(camera)
+    moving_renderer.SetActiveCamera(moving_camera)
+    moving_mapper, _ = add_cut_volume(scene, intensities, cut, moving_renderer)
+    moving_mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    moving_mapper.SetMaximumImageSampleDistance(4)
+    moving_mapper.GetRayCaster().SetAmbientOcclusion(True)
+    # The camera moves: the window asks for 1000 frames per second, more
+    # than any full frame gives, so every frame is the coarsest.
+    moving.SetDesiredUpdateRate(1000.0)
+    for angle in (5.0, -5.0):
+        moving_camera.Azimuth(angle)
+        moving.Render()
+        assert moving_mapper.GetLastImageSampleDistance() == 4
+        assert moving_mapper.GetRayCaster().GetNumberOfRaysCast() <= math.ceil(width / 4) * math.ceil(height / 4)
+    reduced = read_window(moving, width, height)
+    # Magnified, not shifted: the reduced image covers the same pixels as the
+    # full one but for the blocks along the silhouette.
+    covered_full, covered_reduced = full[0] < 1.0, reduced[0] < 1.0
+    assert np.mean(covered_full != covered_reduced) < 0.08
+    assert not np.array_equal(full[1], reduced[1])
+    # The motion stops: the window's rate drops back and the next frame is the full image.
+    moving.SetDesiredUpdateRate(0.0001)
+    moving.Render()
+    assert moving_mapper.GetLastImageSampleDistance() == 1
+    assert moving_mapper.GetRayCaster().GetNumberOfRaysCast() == width * height
+    refined = read_window(moving, width, height)
+    assert np.array_equal(refined[0], full[0])
+    assert np.array_equal(refined[1], full[1])
+
+
+def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
+    width = 128
+    window, renderer = render_window(width)
+    renderer.SetActiveCamera(A.make_camera(scene, 4.0, width, width))
+    mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    window.Render()  # shaders and textures made
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    # A rate the last full frame meets leaves the image at full resolution;
+    # one that allows a sixteenth of it (within the maximum) reduces it to
+    # a ray per 4 x 4 pixels.
+    window.SetDesiredUpdateRate(0.5 / mapper.GetLastFrameTime())
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    window.SetDesiredUpdateRate(16.0 / mapper.GetLastFrameTime())
+    renderer.GetActiveCamera().Azimuth(3.0)
+    window.Render()
+    assert 4 <= mapper.GetLastImageSampleDistance() <= 5

@@ -1,0 +1,234 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+// Step 1 of adaptive sampling, classification at a sample point: which
+// segment's object is there and the CT value (vtkVolumeCutSampleClassifier.h
+// documents it). Replaces the skeleton's VolumeCut::Classification::Dec tag.
+
+uniform sampler3D anatomyTexture;   // CT (R32F), fetched texel by texel
+uniform sampler3D labelTexture;     // labels (R32F), when hasLabels
+uniform sampler2D styleTexture;     // per label: (rgb, opacity), (iso, shape, 0, 0), (uncut surface rgb, 0)
+uniform int hasLabels;             // a label map or fractional labelmaps
+uniform int hasLabelMap;
+uniform sampler3D fractionTexture;  // up to 4 segments' fractions (RGBA)
+uniform int fractionCount;
+uniform vec4 fractionLabels;
+uniform int styleCount;
+uniform int anyIso;
+uniform float minimumIso;
+
+void cellOf(vec3 p, out ivec3 base, out vec3 f)
+{
+  vec3 x = clamp(p, vec3(0.0), vec3(dimensions - 1));
+  base = min(ivec3(x), dimensions - 2);
+  f = x - vec3(base);
+}
+
+float intensity(vec3 p)
+{
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  float v000 = texelFetch(anatomyTexture, b, 0).r;
+  float v100 = texelFetch(anatomyTexture, b + ivec3(1, 0, 0), 0).r;
+  float v010 = texelFetch(anatomyTexture, b + ivec3(0, 1, 0), 0).r;
+  float v110 = texelFetch(anatomyTexture, b + ivec3(1, 1, 0), 0).r;
+  float v001 = texelFetch(anatomyTexture, b + ivec3(0, 0, 1), 0).r;
+  float v101 = texelFetch(anatomyTexture, b + ivec3(1, 0, 1), 0).r;
+  float v011 = texelFetch(anatomyTexture, b + ivec3(0, 1, 1), 0).r;
+  float v111 = texelFetch(anatomyTexture, b + ivec3(1, 1, 1), 0).r;
+  float c00 = v000 + f.x * (v100 - v000);
+  float c10 = v010 + f.x * (v110 - v010);
+  float c01 = v001 + f.x * (v101 - v001);
+  float c11 = v011 + f.x * (v111 - v011);
+  float c0 = c00 + f.y * (c10 - c00);
+  float c1 = c01 + f.y * (c11 - c01);
+  return c0 + f.z * (c1 - c0);
+}
+
+vec4 styleColor(int label) { return texelFetch(styleTexture, ivec2(label, 0), 0); }
+vec4 styleSurface(int label) { return texelFetch(styleTexture, ivec2(label, 1), 0); }
+vec3 styleSurfaceColor(int label) { return texelFetch(styleTexture, ivec2(label, 2), 0).rgb; }
+
+float cornerWeight(int corner, vec3 f)
+{
+  return ((corner & 1) != 0 ? f.x : 1.0 - f.x) * ((corner & 2) != 0 ? f.y : 1.0 - f.y) * ((corner & 4) != 0 ? f.z : 1.0 - f.z);
+}
+
+ivec3 cornerOffset(int corner) { return ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1); }
+
+vec4 fractionsAt(vec3 p)
+{
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  vec4 value = vec4(0.0);
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    value += cornerWeight(corner, f) * texelFetch(fractionTexture, b + cornerOffset(corner), 0);
+  }
+  return value;
+}
+
+bool shownIsoSegment(int label)
+{
+  return label > 0 && label < styleCount && styleColor(label).a > 0.0 && styleSurface(label).y <= 0.5;
+}
+
+// The segment of greatest weight at p (vtkVolumeCutSampleClassifier::
+// StrongestLabel). materialOnly: only the corners of shown iso-defined
+// segments inside their surface count (MaterialOwner); otherwise every
+// labelled corner, and unlabelled bright material competes (DominantLabel).
+int strongestLabel(vec3 p, bool materialOnly, out float weight)
+{
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  int labels[12];
+  float weights[12];
+  int count = 0;
+  float unlabelledBright = 0.0;
+  for (int corner = 0; corner < 8 && hasLabelMap != 0; ++corner)
+  {
+    int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
+    float w = cornerWeight(corner, f);
+    if (materialOnly)
+    {
+      if (!shownIsoSegment(label) || texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r < styleSurface(label).x)
+      {
+        continue;
+      }
+    }
+    else if (label == 0)
+    {
+      if (anyIso != 0 && texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r >= minimumIso)
+      {
+        unlabelledBright += w;
+      }
+      continue;
+    }
+    int slot = 0;
+    while (slot < count && labels[slot] != label)
+    {
+      ++slot;
+    }
+    if (slot == count)
+    {
+      labels[count] = label;
+      weights[count] = 0.0;
+      ++count;
+    }
+    weights[slot] += w;
+  }
+  if (fractionCount > 0)
+  {
+    vec4 fractions = fractionsAt(p);
+    for (int i = 0; i < fractionCount; ++i)
+    {
+      int label = int(fractionLabels[i] + 0.5);
+      if (materialOnly && !shownIsoSegment(label))
+      {
+        continue;
+      }
+      int slot = 0;
+      while (slot < count && labels[slot] != label)
+      {
+        ++slot;
+      }
+      if (slot == count)
+      {
+        labels[count] = label;
+        ++count;
+      }
+      weights[slot] = fractions[i];
+    }
+  }
+  int best = 0;
+  weight = 0.0;
+  for (int slot = 0; slot < count; ++slot)
+  {
+    if (weights[slot] > weight || (weights[slot] == weight && weight > 0.0 && labels[slot] < best))
+    {
+      best = labels[slot];
+      weight = weights[slot];
+    }
+  }
+  if (!materialOnly && unlabelledBright > weight)
+  {
+    return 0;
+  }
+  return best;
+}
+
+int dominantLabel(vec3 p, out float weight) { return strongestLabel(p, false, weight); }
+
+// The segment whose material lies under an iso-surface point (0 for none).
+int materialOwner(vec3 p)
+{
+  float weight;
+  return strongestLabel(p, true, weight);
+}
+
+float indicator(int label, vec3 p)
+{
+  for (int i = 0; i < fractionCount; ++i)
+  {
+    if (int(fractionLabels[i] + 0.5) == label)
+    {
+      return fractionsAt(p)[i];
+    }
+  }
+  if (hasLabelMap == 0)
+  {
+    return 0.0;
+  }
+  ivec3 b;
+  vec3 f;
+  cellOf(p, b, f);
+  float value = 0.0;
+  for (int corner = 0; corner < 8; ++corner)
+  {
+    if (int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5) == label)
+    {
+      value += cornerWeight(corner, f);
+    }
+  }
+  return value;
+}
+
+int objectAt(vec3 p, out float value)
+{
+  value = intensity(p);
+  if (hasLabels == 0)
+  {
+    vec4 s = styleSurface(1);
+    return (styleColor(1).a > 0.0 && value >= s.x) ? 1 : 0;
+  }
+  float weight;
+  int label = dominantLabel(p, weight);
+  if (label == 0 || label >= styleCount || styleColor(label).a <= 0.0)
+  {
+    return 0;
+  }
+  vec4 s = styleSurface(label);
+  bool inside = s.y > 0.5 ? weight >= 0.5 : value >= s.x;
+  return inside ? label : 0;
+}
+
+Sample sampleAt(float t)
+{
+  Sample s;
+  s.t = t;
+  s.index = rayOrigin + t * rayDirection;
+  s.object = 0;
+  s.value = 0.0;
+  s.cutsKnown = false;
+  for (int n = 0; n < CUT_SLOTS; ++n)
+  {
+    s.distance[n] = 1.0;
+  }
+  return s;
+}
+
+void evaluateObject(inout Sample s) { s.object = objectAt(s.index, s.value); }
+
+vec3 worldPoint(vec3 index) { return (ijkToWorld * vec4(index, 1.0)).xyz; }

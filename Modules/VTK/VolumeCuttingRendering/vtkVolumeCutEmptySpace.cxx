@@ -1,0 +1,143 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutEmptySpace.h"
+
+#include "vtkVolumeCutParallelFor.h"
+#include "vtkVolumeCutRayScene.h"
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximumThreads)
+{
+  const int* dims = scene.Dimensions;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    this->Dimensions[axis] = (dims[axis] - 1 + BlockSize - 1) / BlockSize;
+  }
+  const vtkIdType blockCount = static_cast<vtkIdType>(this->Dimensions[0]) * this->Dimensions[1] * this->Dimensions[2];
+  this->Occupied.assign(blockCount, 0);
+  this->GradientBound.assign(blockCount, 0.f);
+  const bool composite = scene.BlendMode == 1;
+  const std::vector<float>& values = scene.Values;
+  const std::vector<vtkVolumeCutRayScene::SegmentStyle>& styles = scene.Styles;
+  constexpr int TableSize = vtkVolumeCutRayScene::TransferTableSize;
+  vtkVolumeCutParallelFor(maximumThreads, this->Dimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+    for (vtkIdType bz = beginZ; bz < endZ; ++bz)
+    {
+      for (int by = 0; by < this->Dimensions[1]; ++by)
+      {
+        for (int bx = 0; bx < this->Dimensions[0]; ++bx)
+        {
+          const vtkIdType block = bx + this->Dimensions[0] * (by + static_cast<vtkIdType>(this->Dimensions[1]) * bz);
+          // The block's cells and their far corners (one voxel of apron).
+          const int k0 = int(bz) * BlockSize;
+          const int k1 = std::min((int(bz) + 1) * BlockSize, dims[2] - 1);
+          const int j0 = by * BlockSize;
+          const int j1 = std::min((by + 1) * BlockSize, dims[1] - 1);
+          const int i0 = bx * BlockSize;
+          const int i1 = std::min((bx + 1) * BlockSize, dims[0] - 1);
+          float lo = std::numeric_limits<float>::infinity();
+          float hi = -std::numeric_limits<float>::infinity();
+          bool occupied = false;
+          float slope[3] = { 0.f, 0.f, 0.f };
+          for (int k = k0; k <= k1; ++k)
+          {
+            for (int j = j0; j <= j1; ++j)
+            {
+              const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
+              for (int i = i0; i <= i1; ++i)
+              {
+                const float v = values[row + i];
+                lo = v < lo ? v : lo;
+                hi = v > hi ? v : hi;
+                // Largest change to a neighbour along each axis bounds the
+                // trilinear gradient's components.
+                if (i + 1 < dims[0])
+                {
+                  slope[0] = std::max(slope[0], std::abs(values[row + i + 1] - v));
+                }
+                if (j + 1 < dims[1])
+                {
+                  slope[1] = std::max(slope[1], std::abs(values[row + dims[0] + i] - v));
+                }
+                if (k + 1 < dims[2])
+                {
+                  slope[2] = std::max(slope[2], std::abs(values[row + static_cast<vtkIdType>(dims[0]) * dims[1] + i] - v));
+                }
+              }
+            }
+          }
+          // Labels: a visible segment whose surface could lie in the block.
+          if (!composite && !scene.Labels.empty())
+          {
+            for (int k = k0; k <= k1 && !occupied; ++k)
+            {
+              for (int j = j0; j <= j1 && !occupied; ++j)
+              {
+                const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
+                for (int i = i0; i <= i1; ++i)
+                {
+                  const int label = scene.Labels[row + i];
+                  if (label > 0 && label < static_cast<int>(styles.size()))
+                  {
+                    const vtkVolumeCutRayScene::SegmentStyle& style = styles[label];
+                    if (style.Opacity > 0.f && (style.Shape || hi >= style.Iso))
+                    {
+                      occupied = true;
+                      break;
+                    }
+                  }
+                }
+              }
+            }
+          }
+          if (!composite && !occupied)
+          {
+            // Fractional segments: any voxel of the block partly inside a shown one.
+            for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
+            {
+              const vtkVolumeCutRayScene::SegmentStyle& style =
+                fraction.Label < static_cast<int>(styles.size()) ? styles[fraction.Label] : styles[0];
+              if (occupied || style.Opacity <= 0.f || (!style.Shape && hi < style.Iso))
+              {
+                continue;
+              }
+              for (int k = k0; k <= k1 && !occupied; ++k)
+              {
+                for (int j = j0; j <= j1 && !occupied; ++j)
+                {
+                  const vtkIdType row = static_cast<vtkIdType>(dims[0]) * (j + static_cast<vtkIdType>(dims[1]) * k);
+                  for (int i = i0; i <= i1 && !occupied; ++i)
+                  {
+                    occupied = fraction.Values[row + i] > 0.f;
+                  }
+                }
+              }
+            }
+          }
+          if (!composite && !scene.HasSegments())
+          {
+            occupied = styles[1].Opacity > 0.f && hi >= styles[1].Iso;
+          }
+          else if (composite)
+          {
+            // Any opacity over the block's value range.
+            const double span = scene.TableRange[1] - scene.TableRange[0];
+            const int first =
+              span > 0.0 ? std::max(0, static_cast<int>(std::floor((lo - scene.TableRange[0]) / span * (TableSize - 1)))) : 0;
+            const int last = span > 0.0
+              ? std::min(TableSize - 1, static_cast<int>(std::ceil((hi - scene.TableRange[0]) / span * (TableSize - 1))))
+              : TableSize - 1;
+            for (int n = std::min(first, TableSize - 1); n <= last && !occupied; ++n)
+            {
+              occupied = scene.OpacityTable[n] > 0.f;
+            }
+          }
+          this->Occupied[block] = occupied ? 1 : 0;
+          // NaN voxels make the bound infinite: such blocks are always refined.
+          const float lipschitz = std::sqrt(slope[0] * slope[0] + slope[1] * slope[1] + slope[2] * slope[2]);
+          this->GradientBound[block] = std::isfinite(lipschitz) ? lipschitz : std::numeric_limits<float>::infinity();
+        }
+      }
+    }
+  });
+}

@@ -1,0 +1,79 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+// Private to VolumeCuttingRendering (not installed, not wrapped).
+/**
+ * @class   vtkVolumeCutEmptySpace
+ * @brief   Empty-space skipping of vtkVolumeCutRayCaster: blocks of 8^3 cells.
+ *
+ * Per block of BlockSize^3 cells of the anatomy (with the far corners, one
+ * voxel of apron): whether a visible object can be there (a shown segment
+ * whose surface could lie in it, or any opacity over its CT range in
+ * composite mode), and a bound on the CT's trilinear gradient (per voxel)
+ * that the border locator uses to decide whether a border could hide between
+ * two samples. Rays step over empty blocks in one jump.
+ */
+#ifndef vtkVolumeCutEmptySpace_h
+#define vtkVolumeCutEmptySpace_h
+
+#include <vtkType.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+struct vtkVolumeCutRayScene;
+
+class vtkVolumeCutEmptySpace
+{
+public:
+  static constexpr int BlockSize = 8;
+
+  /// Classify every block of \a scene (values, segments, styles and tables
+  /// already copied), on at most maximumThreads threads.
+  void Build(const vtkVolumeCutRayScene& scene, int maximumThreads);
+
+  bool Empty(const double p[3]) const { return !this->Occupied[this->BlockOf(p)]; }
+
+  /// Bound of the CT's gradient (CT units per voxel) in the block holding p.
+  float Lipschitz(const double p[3]) const { return this->GradientBound[this->BlockOf(p)]; }
+
+  /// Ray parameter where the ray (direction d in voxels) leaves the block holding p.
+  double Exit(const double p[3], const double d[3], double t) const
+  {
+    double exit = std::numeric_limits<double>::infinity();
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      if (std::abs(d[axis]) < 1e-12)
+      {
+        continue;
+      }
+      const int b = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->Dimensions[axis] - 1);
+      const double wall = d[axis] > 0.0 ? double((b + 1) * BlockSize) : double(b * BlockSize);
+      exit = std::min(exit, t + (wall - p[axis]) / d[axis]);
+    }
+    return exit;
+  }
+
+  const int* GetDimensions() const { return this->Dimensions; }
+  const uint8_t* GetOccupied() const { return this->Occupied.data(); }
+  const float* GetGradientBounds() const { return this->GradientBound.data(); }
+
+private:
+  vtkIdType BlockOf(const double p[3]) const
+  {
+    int b[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      b[axis] = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->Dimensions[axis] - 1);
+    }
+    return b[0] + this->Dimensions[0] * (b[1] + this->Dimensions[1] * b[2]);
+  }
+
+  int Dimensions[3] = { 0, 0, 0 };
+  std::vector<uint8_t> Occupied;
+  std::vector<float> GradientBound;
+};
+
+#endif

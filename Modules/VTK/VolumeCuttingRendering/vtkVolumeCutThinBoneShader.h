@@ -1,0 +1,84 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+// Private to VolumeCuttingRendering (not installed, not wrapped).
+/**
+ * @class   vtkVolumeCutThinBoneShader
+ * @brief   Thin-bone shading (Morris et al., seed 003): bone thinner than a threshold turns red and translucent.
+ *
+ * From a surface point, marches inward (against the outward normal) in
+ * quarter-voxel steps until no visible material is left, whatever its
+ * segment (cortical over trabecular bone is one wall), up to the threshold;
+ * a wall thinner than that is tinted red and made translucent in proportion,
+ * so that what lies behind it shows through.
+ */
+#ifndef vtkVolumeCutThinBoneShader_h
+#define vtkVolumeCutThinBoneShader_h
+
+#include "vtkVolumeCutSampleClassifier.h"
+
+#include <vtkMath.h>
+
+class vtkVolumeCutThinBoneShader
+{
+public:
+  vtkVolumeCutThinBoneShader(const vtkVolumeCutRayScene& scene, const vtkVolumeCutSampleClassifier& classifier)
+    : Scene(scene)
+    , Classifier(classifier)
+  {
+  }
+
+  /// Thickness (mm, at most the threshold) of the wall under a surface point (IJK) with this outward world normal.
+  double MeasureThickness(const double index[3], const double normalWorld[3]) const
+  {
+    const double threshold = this->Scene.ThinBoneThickness;
+    double inward[3] = { -normalWorld[0], -normalWorld[1], -normalWorld[2] };
+    double inwardIndex[3];
+    vtkVolumeCutRayMath::TransformVector(this->Scene.WorldToIJK, inward, inwardIndex);
+    const double voxelsPerMillimetre = vtkMath::Norm(inwardIndex);
+    if (voxelsPerMillimetre <= 0.0)
+    {
+      return threshold;
+    }
+    const double step = 0.25 / voxelsPerMillimetre;
+    for (double travelled = step; travelled < threshold; travelled += step)
+    {
+      vtkVolumeCutSample s;
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        s.Index[axis] = index[axis] + travelled * inwardIndex[axis];
+        if (s.Index[axis] < 0.0 || s.Index[axis] > this->Scene.Dimensions[axis] - 1)
+        {
+          return threshold;
+        }
+      }
+      this->Classifier.EvaluateObject(s);
+      if (!this->Classifier.Visible(s))
+      {
+        return travelled;
+      }
+    }
+    return threshold;
+  }
+
+  /// Tint a shaded surface colour and its opacity by the wall's thickness there.
+  void Apply(const double index[3], const double normalWorld[3], float rgb[3], float& alpha) const
+  {
+    const double thickness = this->MeasureThickness(index, normalWorld);
+    if (thickness < this->Scene.ThinBoneThickness)
+    {
+      const float f = static_cast<float>(thickness / this->Scene.ThinBoneThickness);
+      const float red[3] = { 1.f, 0.12f, 0.08f };
+      for (int c = 0; c < 3; ++c)
+      {
+        rgb[c] = red[c] * (1.f - f) + rgb[c] * f;
+      }
+      alpha *= 0.3f + 0.7f * f;
+    }
+  }
+
+private:
+  const vtkVolumeCutRayScene& Scene;
+  const vtkVolumeCutSampleClassifier& Classifier;
+};
+
+#endif
