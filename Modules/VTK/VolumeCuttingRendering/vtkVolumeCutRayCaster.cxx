@@ -1102,6 +1102,9 @@ void vtkVolumeCutRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "ThinBoneShading: " << this->ThinBoneShading << " (" << this->ThinBoneThickness << " mm)\n";
   os << indent << "Lighting: ambient " << this->Ambient << ", diffuse " << this->Diffuse << ", specular " << this->Specular << "^"
      << this->SpecularPower << "\n";
+  os << indent << "AmbientOcclusion: " << this->AmbientOcclusion << " (" << this->AmbientOcclusionRadius << " mm)\n";
+  os << indent << "LabelSmoothing: " << this->LabelSmoothing << "\n";
+  os << indent << "DraftQuality: " << this->DraftQuality << "\n";
   os << indent << "MaximumNumberOfThreads: " << this->MaximumNumberOfThreads << "\n";
   os << indent << "Anatomy: " << this->Impl->Anatomy.GetPointer() << "\n";
   os << indent << "LabelMap: " << this->Impl->LabelMap.GetPointer() << "\n";
