@@ -239,6 +239,12 @@ int vtkSlicerVolumeCuttingHapticSession::Update()
   {
     this->Logic->MoveActiveTool(this->CutNode, this->Pose, vtkSlicerVolumeCuttingLogic::ToolMove);
   }
+  if ((cuts > 0) != this->Drilling)
+  {
+    this->Drilling = cuts > 0;
+    this->CutNode->InvokeCustomModifiedEvent(
+      this->Drilling ? vtkMRMLVolumeCutNode::StrokeStartedEvent : vtkMRMLVolumeCutNode::StrokeEndedEvent);
+  }
   if (cuts > 0)
   {
     // Views re-render; they find the bricks the haptic thread changed by their stamps.
@@ -272,6 +278,7 @@ void vtkSlicerVolumeCuttingHapticSession::Stop()
   this->CutNode = nullptr;
   this->Device = nullptr;
   this->FootSwitch = nullptr;
+  this->Drilling = false;
 }
 
 //----------------------------------------------------------------------------

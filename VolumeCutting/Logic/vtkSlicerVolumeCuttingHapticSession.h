@@ -125,6 +125,8 @@ protected:
   vtkSmartPointer<vtkHapticDevice> FootSwitch;
   double DeviceScale = 1.0;
   double ReportedContactDepth = 0.0;
+  /// Whether the last update saw cuts: views are told when drilling starts and stops.
+  bool Drilling = false;
 
 private:
   vtkSlicerVolumeCuttingHapticSession(const vtkSlicerVolumeCuttingHapticSession&) = delete;

@@ -785,6 +785,7 @@ bool vtkSlicerVolumeCuttingLogic::BeginStroke(vtkMRMLVolumeCutNode* cutNode)
   // A stroke of the active tool starts where its first pose puts it.
   this->StrokePoses.erase(cutNode->GetID());
   field->BeginStroke();
+  cutNode->InvokeCustomModifiedEvent(vtkMRMLVolumeCutNode::StrokeStartedEvent);
   return true;
 }
 
@@ -888,6 +889,7 @@ bool vtkSlicerVolumeCuttingLogic::EndStroke(vtkMRMLVolumeCutNode* cutNode)
   field->EndStroke();
   this->RecordContact(cutNode, field);
   this->UpdateTablesAfterChange(cutNode);
+  cutNode->InvokeCustomModifiedEvent(vtkMRMLVolumeCutNode::StrokeEndedEvent);
   return true;
 }
 

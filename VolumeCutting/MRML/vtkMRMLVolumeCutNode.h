@@ -74,7 +74,12 @@ public:
     /// Invoked (by the logic) when a tool went deeper into a segment it may
     /// not cut: the logic's GetContactSegmentID and the field's contact depth
     /// and position say where. A GUI highlights it at once.
-    ProtectedContactEvent
+    ProtectedContactEvent,
+    /// Invoked (by the logic, on the main thread) when a stroke begins (the
+    /// drill pressed with the mouse or a device) and when it ends: views draw
+    /// reduced images while it lasts and the full image after.
+    StrokeStartedEvent,
+    StrokeEndedEvent
   };
 
   ///@{

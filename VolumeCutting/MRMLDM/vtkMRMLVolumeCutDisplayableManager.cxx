@@ -25,6 +25,8 @@
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 #include <vtkVolume.h>
@@ -33,6 +35,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 
 vtkStandardNewMacro(vtkMRMLVolumeCutDisplayableManager);
@@ -51,6 +54,8 @@ struct vtkMRMLVolumeCutDisplayableManager::Internals
     std::string FractionSource;
   };
   std::map<vtkMRMLVolumeCutNode*, Pipeline> Pipelines;
+  std::set<vtkMRMLVolumeCutNode*> NodesInStroke;
+  bool RateRaised = false;
 };
 
 //---------------------------------------------------------------------------
@@ -95,12 +100,7 @@ void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneNodeAdded(vtkMRMLNode* node)
   {
     return;
   }
-  vtkNew<vtkIntArray> events;
-  events->InsertNextValue(vtkCommand::ModifiedEvent);
-  events->InsertNextValue(vtkMRMLVolumeCutNode::InputDataModifiedEvent);
-  events->InsertNextValue(vtkMRMLVolumeCutNode::SegmentRolesModifiedEvent);
-  events->InsertNextValue(vtkMRMLVolumeCutNode::CutModifiedEvent);
-  vtkObserveMRMLNodeEventsMacro(cutNode, events);
+  this->ObserveCutNode(cutNode);
   this->UpdatePipeline(cutNode);
   this->RequestRender();
 }
@@ -114,6 +114,10 @@ void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneNodeRemoved(vtkMRMLNode* nod
     return;
   }
   vtkUnObserveMRMLNodeMacro(cutNode);
+  if (this->Impl->NodesInStroke.erase(cutNode))
+  {
+    this->UpdateDesiredUpdateRate();
+  }
   auto found = this->Impl->Pipelines.find(cutNode);
   if (found != this->Impl->Pipelines.end())
   {
@@ -131,7 +135,44 @@ void vtkMRMLVolumeCutDisplayableManager::OnMRMLSceneEndClose()
     this->GetRenderer()->RemoveVolume(entry.second.Volume);
   }
   this->Impl->Pipelines.clear();
+  this->Impl->NodesInStroke.clear();
+  this->UpdateDesiredUpdateRate();
   this->RequestRender();
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::ObserveCutNode(vtkMRMLVolumeCutNode* node)
+{
+  vtkNew<vtkIntArray> events;
+  events->InsertNextValue(vtkCommand::ModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::InputDataModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::SegmentRolesModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::CutModifiedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::StrokeStartedEvent);
+  events->InsertNextValue(vtkMRMLVolumeCutNode::StrokeEndedEvent);
+  vtkObserveMRMLNodeEventsMacro(node, events);
+}
+
+//---------------------------------------------------------------------------
+void vtkMRMLVolumeCutDisplayableManager::UpdateDesiredUpdateRate()
+{
+  vtkRenderWindow* window = this->GetRenderer() ? this->GetRenderer()->GetRenderWindow() : nullptr;
+  if (!window)
+  {
+    return;
+  }
+  vtkRenderWindowInteractor* interactor = window->GetInteractor();
+  if (!this->Impl->NodesInStroke.empty())
+  {
+    window->SetDesiredUpdateRate(interactor ? interactor->GetDesiredUpdateRate() : 15.0);
+    this->Impl->RateRaised = true;
+  }
+  else if (this->Impl->RateRaised)
+  {
+    // Only a rate this manager raised is put back: a camera drag owns its own.
+    window->SetDesiredUpdateRate(interactor ? interactor->GetStillUpdateRate() : 0.0001);
+    this->Impl->RateRaised = false;
+  }
 }
 
 //---------------------------------------------------------------------------
@@ -148,12 +189,7 @@ void vtkMRMLVolumeCutDisplayableManager::UpdateFromMRMLScene()
   {
     if (this->Impl->Pipelines.find(vtkMRMLVolumeCutNode::SafeDownCast(node)) == this->Impl->Pipelines.end())
     {
-      vtkNew<vtkIntArray> events;
-      events->InsertNextValue(vtkCommand::ModifiedEvent);
-      events->InsertNextValue(vtkMRMLVolumeCutNode::InputDataModifiedEvent);
-      events->InsertNextValue(vtkMRMLVolumeCutNode::SegmentRolesModifiedEvent);
-      events->InsertNextValue(vtkMRMLVolumeCutNode::CutModifiedEvent);
-      vtkObserveMRMLNodeEventsMacro(node, events);
+      this->ObserveCutNode(vtkMRMLVolumeCutNode::SafeDownCast(node));
     }
     this->UpdatePipeline(vtkMRMLVolumeCutNode::SafeDownCast(node));
   }
@@ -169,7 +205,19 @@ void vtkMRMLVolumeCutDisplayableManager::ProcessMRMLNodesEvents(vtkObject* calle
     this->Superclass::ProcessMRMLNodesEvents(caller, event, callData);
     return;
   }
-  if (event != vtkMRMLVolumeCutNode::CutModifiedEvent)
+  if (event == vtkMRMLVolumeCutNode::StrokeStartedEvent || event == vtkMRMLVolumeCutNode::StrokeEndedEvent)
+  {
+    if (event == vtkMRMLVolumeCutNode::StrokeStartedEvent)
+    {
+      this->Impl->NodesInStroke.insert(cutNode);
+    }
+    else
+    {
+      this->Impl->NodesInStroke.erase(cutNode);
+    }
+    this->UpdateDesiredUpdateRate();
+  }
+  else if (event != vtkMRMLVolumeCutNode::CutModifiedEvent)
   {
     this->UpdatePipeline(cutNode);
   }

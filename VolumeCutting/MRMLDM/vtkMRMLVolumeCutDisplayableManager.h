@@ -60,6 +60,11 @@ protected:
   void ProcessMRMLNodesEvents(vtkObject* caller, unsigned long event, void* callData) override;
 
   void UpdatePipeline(vtkMRMLVolumeCutNode* node);
+  void ObserveCutNode(vtkMRMLVolumeCutNode* node);
+  /// While a stroke lasts the window asks for interactive frames, as Slicer's
+  /// interactor styles do while the camera moves; the mapper then draws
+  /// reduced images, and the full one once the stroke ends.
+  void UpdateDesiredUpdateRate();
 
 private:
   vtkMRMLVolumeCutDisplayableManager(const vtkMRMLVolumeCutDisplayableManager&) = delete;

@@ -161,3 +161,41 @@ def test_fractional_labelmap_segments_are_drawn_at_sub_voxel_accuracy(session):
     z, _ = surface_z(view, 32, 32)
     exact = center[2] + math.sqrt(radius**2 - off_axis**2)
     assert z == pytest.approx(exact, abs=0.1 * scene.spacing)
+
+
+def test_a_stroke_draws_reduced_frames_and_the_full_image_once_it_ends(session):
+    application, scene, volume, cut_node, view = session
+    logic = application.volume_cutting_logic
+    mapper = view.volume_cut_displayable_manager.GetVolumeActor(cut_node).GetMapper()
+    mapper.SetMaximumImageSampleDistance(4)
+    view.render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    window = view.render_window
+    # The rates a desktop view's interactor asks for while something moves and
+    # when it stops (a generic interactor: no display here).
+    interactor = vtk.vtkGenericRenderWindowInteractor()
+    interactor.SetRenderWindow(window)
+    interactor.SetDesiredUpdateRate(1000.0)
+    interactor.SetStillUpdateRate(0.0001)
+    window.SetDesiredUpdateRate(0.0001)
+
+    top = scene.center[2] + scene.half_size
+    pit = [scene.center[0], scene.center[1], top]
+    assert logic.BeginStroke(cut_node)
+    assert window.GetDesiredUpdateRate() == pytest.approx(1000.0)
+    assert logic.CutSphereSweep(cut_node, pit, pit, 2.5)
+    view.render()
+    assert mapper.GetLastImageSampleDistance() == 4
+
+    assert logic.EndStroke(cut_node)
+    assert window.GetDesiredUpdateRate() == pytest.approx(0.0001)
+    view.render()
+    assert mapper.GetLastImageSampleDistance() == 1
+    # The refined frame shows the pit where it is.
+    renderer = view.renderer
+    renderer.SetDisplayPoint(32.5, 32.5, 0.0)
+    renderer.DisplayToWorld()
+    near = renderer.GetWorldPoint()
+    off_axis = math.hypot(near[0] / near[3] - pit[0], near[1] / near[3] - pit[1])
+    z, _ = surface_z(view, 32, 32)
+    assert z == pytest.approx(top - math.sqrt(2.5**2 - off_axis**2), abs=0.02)
