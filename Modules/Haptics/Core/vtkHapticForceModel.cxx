@@ -433,14 +433,16 @@ void vtkHapticForceModel::Update(const double position[3], const double rotation
       move[axis] = (k * (position[axis] - x[axis]) + contact[axis]) / stiffness;
     }
     const double length = Norm(move);
-    if (length < 1e-6)
-    {
-      break;
-    }
     const double scale = length > internal.ProxyStep ? internal.ProxyStep / length : 1.0;
     for (int axis = 0; axis < 3; ++axis)
     {
       x[axis] += scale * move[axis];
+    }
+    // Settled: a further contact test would move the proxy, and the
+    // coupling force, by less than what the next tick corrects anyway.
+    if (length < std::max(this->ProxyTolerance, 1e-9))
+    {
+      break;
     }
   }
 
@@ -623,6 +625,7 @@ void vtkHapticForceModel::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Damping: " << this->Damping << " N s/mm (applied " << this->AppliedDamping << ")\n";
   os << indent << "MaximumForce: " << this->MaximumForce << " N\n";
   os << indent << "ProxyIterations: " << this->ProxyIterations << "\n";
+  os << indent << "ProxyTolerance: " << this->ProxyTolerance << " mm\n";
   os << indent << "FeedRatePerNewton: " << this->FeedRatePerNewton << " mm/s/N\n";
   os << indent << "MaximumFeedRate: " << this->MaximumFeedRate << " mm/s\n";
   os << indent << "GuideEnabled: " << (this->GuideEnabled ? "On" : "Off") << "\n";

@@ -151,6 +151,17 @@ public:
 
   ///@{
   /**
+   * Set/get the proxy step (mm) below which the proxy counts as settled
+   * and the tick's remaining steps are skipped. Each step costs a full
+   * contact test of the shell; a step this short changes the coupling
+   * force by at most CouplingStiffness times it. Default is 0.001 mm.
+   */
+  vtkSetClampMacro(ProxyTolerance, double, 0.0, 1.0);
+  vtkGetMacro(ProxyTolerance, double);
+  ///@}
+
+  ///@{
+  /**
    * Set/get how fast the drill advances into material: mm/s per newton of
    * push, and at most. Defaults are 4 and 20.
    */
@@ -303,6 +314,7 @@ protected:
   double CouplingStiffness = 1.0;
   double Damping = 0.003;
   int ProxyIterations = 6;
+  double ProxyTolerance = 1e-3;
   double FeedRatePerNewton = 4.0;
   double MaximumFeedRate = 20.0;
   double GuideStiffness = 1.0;
