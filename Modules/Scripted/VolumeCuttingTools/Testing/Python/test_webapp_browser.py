@@ -381,6 +381,7 @@ def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(app, shots):
                  60, "the preview")
     app.wait_still(1000, 120)
     previewed = app.three_d_pixels()
+    app.screenshot(shots / "10-softcut-preview.png")
     assert app.total_removed() == 0.0  # a preview cuts nothing
     changed = np.abs(previewed.astype(int) - before.astype(int)).max(axis=2) > 40
     assert changed.mean() > 0.002, f"the preview changed {100 * changed.mean():.2f} % of the view"
@@ -395,7 +396,7 @@ def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(app, shots):
     assert page.evaluate("() => window.trame.state.get('vc_undo_count')") == 1
     app.testid("softcut-panel").scroll_into_view_if_needed()
     app.wait_still(1500, 120)
-    app.screenshot(shots / "10-softcut-carved.png")
+    app.screenshot(shots / "11-softcut-carved.png")
 
 
 def test_the_launcher_gives_each_user_a_scene_of_their_own(browser, tmp_path):

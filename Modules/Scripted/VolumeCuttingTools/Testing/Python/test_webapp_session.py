@@ -296,6 +296,10 @@ def test_softcut_plans_previews_carves_measures_and_exports_the_cheek(head_sessi
     cut = head_session.cut_node
     softcut.show_skin(True)
     assert cut.GetSurfaceIsoValue() == -500.0 and not cut.GetThinBoneShading()
+    # The skin shows through a cuttable soft-tissue segment, drawn under the bone.
+    skin = SoftCutSession.SOFT_TISSUE_SEGMENT_ID
+    assert cut.IsSegmentCuttable(skin) and head_session.segmentation.GetDisplayNode().GetSegmentVisibility3D(skin)
+    assert head_session.segmentation.GetSegmentation().GetSegmentIndex(skin) == 0
     assert softcut.has_example_outline()
     assert softcut.use_example_outline() == 20 and softcut.normal_mode == "average"
     assert len(softcut.outline_points()) == 20
@@ -318,6 +322,7 @@ def test_softcut_plans_previews_carves_measures_and_exports_the_cheek(head_sessi
     assert rows["Surface area"][0] > 0.0 and rows["Surface area"][1] == "mm2"
     # The cut also opens the air just above the skin: the removed volume is at least the resected tissue.
     assert removed > 0.9 * volume
+    assert head_session.removed_volumes()[skin] > 0.9 * volume  # in the segments table
 
     assert head_session.undo() and head_session.total_removed_volume() == 0.0
     assert head_session.redo() and head_session.total_removed_volume() == pytest.approx(removed, rel=1e-9)
@@ -331,6 +336,7 @@ def test_softcut_plans_previews_carves_measures_and_exports_the_cheek(head_sessi
     # Back to drilling: the bone surface again.
     softcut.show_skin(False)
     assert cut.GetSurfaceIsoValue() == 300.0 and cut.GetThinBoneShading()
+    assert not head_session.segmentation.GetDisplayNode().GetSegmentVisibility3D(skin) and cut.IsSegmentCuttable(skin)
     assert head_session.undo() and head_session.total_removed_volume() == 0.0
 
 

@@ -712,15 +712,34 @@ class SoftCutSession:
 
     # -- view
 
+    SOFT_TISSUE_SEGMENT_ID = "SoftCutSoftTissue"
+
     def show_skin(self, shown: bool) -> None:
-        """The 3D view's surface: the skin while SoftCut is used, the bone (and thin-bone shading) for drilling."""
+        """The 3D view's surface: the skin while SoftCut is used, the bone (and thin-bone shading) for drilling.
+
+        The view draws segments only: the skin shows through a cuttable
+        segment of the soft tissue (``softcutjob.soft_tissue_segment``),
+        added on first use, first in order so that bone wins where they
+        overlap, and hidden (still cuttable) for drilling.
+        """
         if not self.session.has_data:
             return
+        self._sync()
         cut_node = self.session.cut_node
+        segmentation = self.session.segmentation
+        segment_id = self.SOFT_TISSUE_SEGMENT_ID
+        if shown and segmentation.GetSegmentation().GetSegment(segment_id) is None:
+            segmentation.GetSegmentation().AddSegment(
+                softcutjob.soft_tissue_segment(self.session.volume, "Skin and soft tissue (SoftCut)"), segment_id)
+            segmentation.GetSegmentation().SetSegmentIndex(segment_id, 0)
+            cut_node.SetCuttableSegmentIDs(list(cut_node.GetCuttableSegmentIDs()) + [segment_id])
         was_modifying = cut_node.StartModify()
         cut_node.SetSurfaceIsoValue(softcutjob.SKIN_ISO_HU if shown else SURFACE_ISO_HU)
         cut_node.SetThinBoneShading(not shown)
         cut_node.EndModify(was_modifying)
+        display = segmentation.GetDisplayNode()
+        if display is not None and segmentation.GetSegmentation().GetSegment(segment_id) is not None:
+            display.SetSegmentVisibility3D(segment_id, bool(shown))
 
     def outline_polydata(self) -> vtk.vtkPolyData:
         """The outline as the page draws it: a ball at each point and a tube through them (closed from 3 points)."""
