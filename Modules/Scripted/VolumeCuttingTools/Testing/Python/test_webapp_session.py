@@ -129,6 +129,18 @@ def test_exports_read_back_with_slicer(session, tmp_path):
     check_exports(paths, session.total_removed_volume(), tmp_path)
 
 
+def open_edges(mesh) -> int:
+    """How many edges of a mesh are on a boundary or shared by more than two faces (0: closed, printable)."""
+    edges = vtk.vtkFeatureEdges()
+    edges.SetInputData(mesh)
+    edges.BoundaryEdgesOn()
+    edges.NonManifoldEdgesOn()
+    edges.FeatureEdgesOff()
+    edges.ManifoldEdgesOff()
+    edges.Update()
+    return edges.GetOutput().GetNumberOfCells()
+
+
 def check_exports(paths, removed_mm3, tmp_path, tolerance_mm3=1e-6):
     """Read every export back with Slicer Core: a closed STL, a segment, a CT, a bundle with the same cut."""
     scene = HeadlessSlicer(tmp_path / "readback-cache")
@@ -136,15 +148,8 @@ def check_exports(paths, removed_mm3, tmp_path, tolerance_mm3=1e-6):
     storage = slicer.vtkMRMLModelStorageNode()
     storage.SetFileName(str(paths["stl"]))
     assert storage.ReadData(model)
-    edges = vtk.vtkFeatureEdges()
-    edges.SetInputData(model.GetPolyData())
-    edges.BoundaryEdgesOn()
-    edges.NonManifoldEdgesOn()
-    edges.FeatureEdgesOff()
-    edges.ManifoldEdgesOff()
-    edges.Update()
     assert model.GetPolyData().GetNumberOfCells() > 100
-    assert edges.GetOutput().GetNumberOfCells() == 0  # closed
+    assert open_edges(model.GetPolyData()) == 0  # closed
 
     segmentation = scene.scene.AddNewNodeByClass("vtkMRMLSegmentationNode")
     segmentation_storage = slicer.vtkMRMLSegmentationStorageNode()
@@ -281,14 +286,7 @@ def closed_stl(path):
     reader.SetFileName(str(path))
     reader.Update()
     mesh = reader.GetOutput()
-    edges = vtk.vtkFeatureEdges()
-    edges.SetInputData(mesh)
-    edges.BoundaryEdgesOn()
-    edges.NonManifoldEdgesOn()
-    edges.FeatureEdgesOff()
-    edges.ManifoldEdgesOff()
-    edges.Update()
-    return mesh, edges.GetOutput().GetNumberOfCells()
+    return mesh, open_edges(mesh)
 
 
 def test_softcut_plans_previews_carves_measures_and_exports_the_cheek(head_session):
