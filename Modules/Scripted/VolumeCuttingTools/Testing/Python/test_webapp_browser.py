@@ -353,8 +353,14 @@ def test_an_own_scan_by_its_server_path_is_segmented_automatically_and_drilled(b
     context.close()
 
 
-def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(app, shots):
+def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(browser, server, shots):
+    # A page of its own: the first page was lost on purpose above.
+    context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1)
+    app = AppPage(context.new_page(), timing=True)
+    app.open(server.url)
+    app.wait_ready(120)
     page = app.page
+    page.set_default_timeout(60000)
     if app.testid("take-over").is_visible():
         app.testid("take-over").click()
     page.locator('[data-testid="source"]').click()
@@ -397,6 +403,7 @@ def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(app, shots):
     app.testid("softcut-panel").scroll_into_view_if_needed()
     app.wait_still(1500, 120)
     app.screenshot(shots / "11-softcut-carved.png")
+    context.close()
 
 
 def test_the_launcher_gives_each_user_a_scene_of_their_own(browser, tmp_path):
