@@ -53,22 +53,7 @@ def _colour_segments(application, volume):
     if segmentation is None:
         raise RuntimeError("SoftCut: the bone segmentation failed (see the log)")
     segmentation.SetName("SoftCut anatomy")
-    ct = nodes.array_from_volume_node(volume)
-    soft = ct > SKIN_ISO_HU
-    # Two voxels into the air, so that the skin's iso-surface lies inside the segment everywhere.
-    grown = soft.copy()
-    for _ in range(2):
-        step = grown.copy()
-        for axis in range(3):
-            step |= np.roll(grown, 1, axis) | np.roll(grown, -1, axis)
-        grown = step
-    image = slicer.vtkOrientedImageData()
-    image.ShallowCopy(nodes.image_data_from_array(grown.astype(np.uint8)))
-    image.SetImageToWorldMatrix(nodes.numpy_to_vtk_matrix(nodes.volume_node_ijk_to_ras(volume)))
-    segment = slicer.vtkSegment()
-    segment.SetName("Soft tissue")
-    segment.AddRepresentation("Binary labelmap", image)
-    segmentation.GetSegmentation().AddSegment(segment, "SoftTissue")
+    segmentation.GetSegmentation().AddSegment(soft_tissue_segment(volume), "SoftTissue")
     colours = {"SoftTissue": SOFT_TISSUE_COLOR, logic.GetCorticalBoneSegmentID(): BONE_COLOR,
                logic.GetTrabecularBoneSegmentID(): BONE_COLOR}
     display = segmentation.GetDisplayNode()
@@ -81,6 +66,28 @@ def _colour_segments(application, volume):
     for index, segment_id in enumerate(ordered):
         segmentation.GetSegmentation().SetSegmentIndex(segment_id, index)
     return segmentation, ordered
+
+
+def soft_tissue_segment(volume, name="Soft tissue"):
+    """A segment of everything above the skin's iso-value, grown two voxels into the air.
+
+    The cut view draws only segments: with it the skin shows, and the skin's
+    iso-surface lies inside the segment everywhere.
+    """
+    grown = nodes.array_from_volume_node(volume) > SKIN_ISO_HU
+    for _ in range(2):
+        step = grown.copy()
+        for axis in range(3):
+            step |= np.roll(grown, 1, axis) | np.roll(grown, -1, axis)
+        grown = step
+    image = slicer.vtkOrientedImageData()
+    image.ShallowCopy(nodes.image_data_from_array(grown.astype(np.uint8)))
+    image.SetImageToWorldMatrix(nodes.numpy_to_vtk_matrix(nodes.volume_node_ijk_to_ras(volume)))
+    segment = slicer.vtkSegment()
+    segment.SetName(name)
+    segment.SetColor(*SOFT_TISSUE_COLOR)
+    segment.AddRepresentation("Binary labelmap", image)
+    return segment
 
 
 def _outline_model(scene, planner, name):

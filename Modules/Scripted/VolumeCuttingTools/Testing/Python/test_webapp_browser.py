@@ -19,7 +19,10 @@ module; the tests run in file order on its page, each wait time-limited:
    stroke, and a second tab on the session: a clear message, nothing lost;
    then a scan of the user's own by its server path, without segmentation:
    the bone is segmented automatically (with progress) and drilled;
-9. several users through wslink's launcher (a process and a scene each).
+9. SoftCut on the example head CT: a click in the SoftCut outline mode
+   places a point on the skin, the example cheek outline is planned,
+   previewed in the 3D view, carved (one undo step) and measured;
+10. several users through wslink's launcher (a process and a scene each).
 
 Screenshots of the steps go to ``$VOLUMECUTTING_SCREENSHOTS`` (Docs/webapp
 holds the committed ones), else into pytest's temporary folder.
@@ -347,6 +350,59 @@ def test_an_own_scan_by_its_server_path_is_segmented_automatically_and_drilled(b
     page.set_mode("drill")
     page.drag([view_point(page, 0.40 + 0.004 * i, 0.50) for i in range(30)], 20)
     page.wait_for_total_removed("v > 1", 60)
+    context.close()
+
+
+def test_softcut_plans_previews_and_carves_the_cheek_on_the_head_ct(browser, server, shots):
+    # A page of its own: the first page was lost on purpose above.
+    context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1)
+    app = AppPage(context.new_page(), timing=True)
+    app.open(server.url)
+    app.wait_ready(120)
+    page = app.page
+    page.set_default_timeout(60000)
+    if app.testid("take-over").is_visible():
+        app.testid("take-over").click()
+    page.locator('[data-testid="source"]').click()
+    page.locator(".v-overlay--active .v-list-item", has_text="Example head CT").click()
+    app.testid("load").click()
+    app.wait_for("() => (document.querySelector('[data-testid=status]')?.textContent || '').includes('Ready: Example head CT')",
+                 120, "the head CT to be ready")
+    app.wait_still(1000, 120)
+    # A click on the head in the outline mode: a point on the skin (the view turns to the skin).
+    app.set_mode("outline")
+    app.wait_still(1000, 120)
+    page.mouse.click(*view_point(app, 0.5, 0.5))
+    app.wait_for("() => window.trame.state.get('vc_sc_points') === 1", 30, "a point of the outline")
+    app.testid("softcut-clear").click()
+    app.testid("softcut-example").click()
+    app.wait_for("() => window.trame.state.get('vc_sc_points') === 20", 60, "the example cheek outline")
+    app.set_mode("navigate")
+    # The right cheek, from the patient's right front (the main job's view).
+    page.evaluate("() => window.trame.state.set('vc_sc_depth', 8)")
+    app.wait_still(800, 120)
+    before = app.three_d_pixels()
+    app.testid("softcut-preview").click()
+    app.wait_for("() => (document.querySelector('[data-testid=softcut-status]')?.textContent || '').includes('Preview at 8 mm')",
+                 60, "the preview")
+    app.wait_still(1000, 120)
+    previewed = app.three_d_pixels()
+    app.screenshot(shots / "10-softcut-preview.png")
+    assert app.total_removed() == 0.0  # a preview cuts nothing
+    changed = np.abs(previewed.astype(int) - before.astype(int)).max(axis=2) > 40
+    assert changed.mean() > 0.002, f"the preview changed {100 * changed.mean():.2f} % of the view"
+    app.testid("softcut-carve").click()
+    removed = app.wait_for_total_removed("v > 3000", 120)
+    app.wait_for("() => !!document.querySelector('[data-measurement=\"Resected volume\"]')", 60, "the measurements")
+    volume = float(page.locator('[data-measurement="Resected volume"] td').nth(1).inner_text().split()[0])
+    assert 4000.0 < volume < 8000.0 and removed > 0.9 * volume
+    for name in ("Surface area", "Length", "Width", "Thickness"):
+        assert page.locator(f'[data-measurement="{name}"]').count() == 1
+    assert app.testid("softcut-error").count() == 0
+    assert page.evaluate("() => window.trame.state.get('vc_undo_count')") == 1
+    app.testid("softcut-panel").scroll_into_view_if_needed()
+    app.wait_still(1500, 120)
+    app.screenshot(shots / "11-softcut-carved.png")
     context.close()
 
 

@@ -16,7 +16,7 @@ from VolumeCuttingLib import owndata
 from VolumeCuttingLib.application import HeadlessSlicer
 from VolumeCuttingLib.webapp import app as webapp
 from VolumeCuttingLib.webapp import views
-from VolumeCuttingLib.webapp.session import DrillSession, SessionError, tool_pose
+from VolumeCuttingLib.webapp.session import DrillSession, SessionError, SoftCutSession, tool_pose
 
 
 @pytest.fixture(scope="module")
@@ -129,6 +129,18 @@ def test_exports_read_back_with_slicer(session, tmp_path):
     check_exports(paths, session.total_removed_volume(), tmp_path)
 
 
+def open_edges(mesh) -> int:
+    """How many edges of a mesh are on a boundary or shared by more than two faces (0: closed, printable)."""
+    edges = vtk.vtkFeatureEdges()
+    edges.SetInputData(mesh)
+    edges.BoundaryEdgesOn()
+    edges.NonManifoldEdgesOn()
+    edges.FeatureEdgesOff()
+    edges.ManifoldEdgesOff()
+    edges.Update()
+    return edges.GetOutput().GetNumberOfCells()
+
+
 def check_exports(paths, removed_mm3, tmp_path, tolerance_mm3=1e-6):
     """Read every export back with Slicer Core: a closed STL, a segment, a CT, a bundle with the same cut."""
     scene = HeadlessSlicer(tmp_path / "readback-cache")
@@ -136,15 +148,8 @@ def check_exports(paths, removed_mm3, tmp_path, tolerance_mm3=1e-6):
     storage = slicer.vtkMRMLModelStorageNode()
     storage.SetFileName(str(paths["stl"]))
     assert storage.ReadData(model)
-    edges = vtk.vtkFeatureEdges()
-    edges.SetInputData(model.GetPolyData())
-    edges.BoundaryEdgesOn()
-    edges.NonManifoldEdgesOn()
-    edges.FeatureEdgesOff()
-    edges.ManifoldEdgesOff()
-    edges.Update()
     assert model.GetPolyData().GetNumberOfCells() > 100
-    assert edges.GetOutput().GetNumberOfCells() == 0  # closed
+    assert open_edges(model.GetPolyData()) == 0  # closed
 
     segmentation = scene.scene.AddNewNodeByClass("vtkMRMLSegmentationNode")
     segmentation_storage = slicer.vtkMRMLSegmentationStorageNode()
@@ -258,3 +263,117 @@ def test_the_glyph_has_the_tool_shape_and_size(session, shape, sizes):
     display.SetShowAxis(True)
     assert views.tool_glyph(session.tool_node).GetBounds()[5] == pytest.approx(bounds[5] + 25.0, rel=0.02)
     session.set_tool(shape="Sphere", diameter=4.0)
+
+
+# --------------------------------------------------------------------------- SoftCut
+
+
+@pytest.fixture(scope="module")
+def head_session(tmp_path_factory):
+    """The example head CT as the page loads it (bone segmented automatically), for SoftCut's cheek outline."""
+    from trame_slicer.core import SlicerApp
+
+    slicer_app = SlicerApp()
+    logic = slicer_app.register_module_logic(slicer.vtkSlicerVolumeCuttingLogic(), logic_name="VolumeCutting")
+    drill_session = DrillSession(slicer_app.scene, logic, tmp_path_factory.mktemp("webapp-softcut"))
+    drill_session.load("headct")
+    yield drill_session
+    drill_session.close()
+
+
+def closed_stl(path):
+    reader = vtk.vtkSTLReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    mesh = reader.GetOutput()
+    return mesh, open_edges(mesh)
+
+
+def test_softcut_plans_previews_carves_measures_and_exports_the_cheek(head_session):
+    softcut = SoftCutSession(head_session)
+    cut = head_session.cut_node
+    softcut.show_skin(True)
+    assert cut.GetSurfaceIsoValue() == -500.0 and not cut.GetThinBoneShading()
+    # The skin shows through a cuttable soft-tissue segment, drawn under the bone.
+    skin = SoftCutSession.SOFT_TISSUE_SEGMENT_ID
+    assert cut.IsSegmentCuttable(skin) and head_session.segmentation.GetDisplayNode().GetSegmentVisibility3D(skin)
+    assert head_session.segmentation.GetSegmentation().GetSegmentIndex(skin) == 0
+    assert softcut.has_example_outline()
+    assert softcut.use_example_outline() == 20 and softcut.normal_mode == "average"
+    assert len(softcut.outline_points()) == 20
+    assert softcut.outline_polydata().GetNumberOfPoints() > 20 * 10  # balls and a closed tube
+
+    # Previews change nothing in the cut: the preview field holds them.
+    softcut.preview(4.0)
+    assert softcut.previewing and cut.GetPreviewCutField() is not None
+    softcut.preview(8.0)
+    assert head_session.total_removed_volume() == 0.0 and head_session.undo_redo_counts() == (0, 0)
+
+    rows = softcut.carve()
+    assert not softcut.previewing and softcut.depth_mm == 8.0
+    removed = head_session.total_removed_volume()
+    assert head_session.undo_redo_counts() == (1, 0)
+    volume, unit = rows["Resected volume"]
+    # The main job's figure for this outline: 5644 mm3, 35.5 x 25.1 x 16.4 mm.
+    assert unit == "mm3" and 4000.0 < volume < 8000.0
+    assert 28.0 < rows["Length"][0] < 45.0 and 18.0 < rows["Width"][0] < 35.0 and 8.0 <= rows["Thickness"][0] < 25.0
+    assert rows["Surface area"][0] > 0.0 and rows["Surface area"][1] == "mm2"
+    # The cut also opens the air just above the skin: the removed volume is at least the resected tissue.
+    assert removed > 0.9 * volume
+    assert head_session.removed_volumes()[skin] > 0.9 * volume  # in the segments table
+
+    assert head_session.undo() and head_session.total_removed_volume() == 0.0
+    assert head_session.redo() and head_session.total_removed_volume() == pytest.approx(removed, rel=1e-9)
+
+    mesh, open_edges = closed_stl(softcut.export_stl())
+    assert mesh.GetNumberOfPolys() > 500 and open_edges == 0
+    bounds = mesh.GetBounds()
+    diagonal = np.linalg.norm([bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]])
+    assert rows["Length"][0] < diagonal < 2.0 * rows["Length"][0] + 2.0 * rows["Thickness"][0]
+
+    # Back to drilling: the bone surface again.
+    softcut.show_skin(False)
+    assert cut.GetSurfaceIsoValue() == 300.0 and cut.GetThinBoneShading()
+    assert not head_session.segmentation.GetDisplayNode().GetSegmentVisibility3D(skin) and cut.IsSegmentCuttable(skin)
+    assert head_session.undo() and head_session.total_removed_volume() == 0.0
+
+
+def test_softcut_bad_input_carves_nothing(head_session):
+    softcut = SoftCutSession(head_session)
+    undo_steps = head_session.undo_redo_counts()
+    removed = head_session.total_removed_volume()
+    with pytest.raises(SessionError, match="no SoftCut outline yet"):
+        softcut.carve(5.0)
+    points = __import__("VolumeCuttingLib.softcut", fromlist=["picked_points"]).picked_points(
+        head_session.volume, (42.0, 62.0, -40.0), (-0.7, -0.7, -0.1), (10.0, 8.0), count=4)
+    softcut.add_point(points[0])
+    softcut.add_point(points[1])
+    with pytest.raises(SessionError, match="3") as error:
+        softcut.preview(5.0)
+    assert "2" in str(error.value)  # the logic's message: how many there are, how many are needed
+    assert not softcut.previewing
+    # A point 25 mm out in the air in front of the cheek.
+    softcut.add_point(points[2] + 25.0 * np.array([0.7, 0.7, 0.1]))
+    with pytest.raises(SessionError, match="control point 3 .* from the skin"):
+        softcut.carve(5.0)
+    assert softcut.remove_last_point() == 2
+    softcut.add_point(points[2])
+    softcut.add_point(points[3])
+    with pytest.raises(SessionError, match="between 0.5 and 20"):
+        softcut.carve(0.0)
+    with pytest.raises(SessionError, match="not one of local, average"):
+        softcut.set_normal_mode("sideways")
+    assert head_session.undo_redo_counts() == undo_steps and head_session.total_removed_volume() == removed
+    # The good outline carves after all that.
+    softcut.carve(3.0)
+    assert head_session.total_removed_volume() > removed
+    assert head_session.undo()
+    softcut.clear_outline()
+    assert softcut.outline_points() == []
+
+
+def test_softcut_example_outline_needs_the_head_ct(session):
+    softcut = SoftCutSession(session)
+    assert not softcut.has_example_outline()
+    with pytest.raises(SessionError, match="example head CT"):
+        softcut.use_example_outline()

@@ -6,7 +6,9 @@
 One page: a 3D view drawn by ``vtkMRMLVolumeCutDisplayableManager`` (the cut
 anatomy through the product's ray caster) and three slice views with the cut
 region's outline (``vtkMRMLVolumeCutSliceDisplayableManager``); panels for
-the data, the segments and their roles, the tool, the drill and the exports.
+the data, the segments and their roles, the tool, the drill, SoftCut
+(soft-tissue resection: outline on the skin, depth preview, carve,
+measurements, STL) and the exports.
 Rendering happens here (offscreen; Mesa llvmpipe without a GPU) and trame-rca
 streams the images.
 
@@ -40,9 +42,10 @@ from trame_slicer.views import Layout, LayoutDirection, ViewLayoutDefinition, Vi
 from trame_server.utils.asynchronous import create_task
 from wslink.websocket import LinkProtocol
 
-from .. import headct, owndata, toolconfig
+from .. import headct, owndata, softcutjob, toolconfig
 from . import rendering, views
-from .session import DrillSession, SessionError
+from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
+                      SessionError, SoftCutSession)
 
 WWW = Path(__file__).with_name("www")
 CLIENT_MODULE = {"serve": {"__volumecutting": str(WWW)}, "scripts": ["__volumecutting/volumecutting.js"]}
@@ -187,6 +190,9 @@ class VolumeCuttingApp(TrameApp):
         self.drill.on_stroke_end = self._on_stroke_end
         self.drill.on_hover = lambda: self.progressive.pointer_moved()
         self.drill.on_depth_changed = self._on_depth_changed
+        self.softcut = SoftCutSession(self.session)
+        self.drill.on_outline_pick = self._on_outline_pick
+        self._outline_model = None
         self._pipeline_creator = slicer.vtkMRMLLayerDMPipelineScriptedCreator()
         self._pipeline_creator.SetPythonCallback(self._create_pipeline)
         slicer.vtkMRMLLayerDMPipelineFactory.GetInstance().AddPipelineCreator(self._pipeline_creator)
@@ -326,6 +332,10 @@ class VolumeCuttingApp(TrameApp):
             "vc_contact": "", "vc_contacts": [],
             "vc_export_error": "", "vc_export_names": {},
             "vc_owner": "", "vc_client_id": "",
+            "vc_sc_points": 0, "vc_sc_example": False, "vc_sc_normal": self.softcut.normal_mode,
+            "vc_sc_depth": self.softcut.depth_mm, "vc_sc_previewing": False, "vc_sc_skin": False,
+            "vc_sc_error": "", "vc_sc_status": "", "vc_sc_measurements": [],
+            "vc_sc_export_name": "resection.stl",
         })
         state.client_only("vc_client_id")
         self._update_mode_hint()
@@ -343,8 +353,11 @@ class VolumeCuttingApp(TrameApp):
         base = "".join(c if c.isalnum() or c in "-_" else "_" for c in self.session.volume.GetName()) or "volume"
         self.state.vc_export_names = {kind: f"{base}-{name}" for kind, (name, _) in EXPORT_FILES.items()}
         self.state.vc_contact = ""
+        self.state.vc_sc_export_name = f"{base}-resection.stl"
         self._refresh_tool()
         self._refresh_tables()
+        self.softcut.show_skin(bool(self.state.vc_sc_skin))
+        self._refresh_softcut(error="")
         self.reset_camera()
 
     def _refresh_tables(self) -> None:
@@ -434,6 +447,7 @@ class VolumeCuttingApp(TrameApp):
             return
         step()
         self.state.vc_contact = ""
+        self.state.vc_sc_status = ""
         self.drill.set_glyph(in_contact=False)
         self._refresh_tables()
 
@@ -445,8 +459,11 @@ class VolumeCuttingApp(TrameApp):
             views.MODE_NAVIGATE: "Navigate: drag to rotate, right-drag to zoom, middle-drag to pan",
             views.MODE_DRILL: "Drill: press and drag on the bone; wheel sets the depth, Shift drills twice as deep",
             views.MODE_RESTORE: "Restore: press and drag to add bone back inside the cut",
+            views.MODE_OUTLINE: "SoftCut outline: click on the skin to place the outline's points, in order around it",
         }
-        self.state.vc_mode_hint = hints[self.drill.mode] + f" (depth {self.drill.depth_mm:.2f} mm)"
+        self.state.vc_mode_hint = hints[self.drill.mode] + (
+            f" ({self.state.vc_sc_points or 0} points)" if self.drill.mode == views.MODE_OUTLINE
+            else f" (depth {self.drill.depth_mm:.2f} mm)")
 
     # ------------------------------------------------------------------ tabs and connections
 
@@ -551,12 +568,73 @@ class VolumeCuttingApp(TrameApp):
             state.vc_export_error = ""
             return self.server.protocol.addAttachment(path.read_bytes())
 
+        @ctrl.trigger("vc_sc_example")
+        def softcut_example():
+            self._softcut_action(self.softcut.use_example_outline, skin=True)
+            if self.state.vc_sc_points:
+                # The cheek from the patient's right front, as the main job shows it.
+                self.three_d_view.look_at(softcutjob.CHEEK_CENTER, softcutjob.VIEW_DIRECTION, 260.0)
+
+        @ctrl.trigger("vc_sc_undo_point")
+        def softcut_undo_point():
+            self._softcut_action(self.softcut.remove_last_point)
+
+        @ctrl.trigger("vc_sc_clear")
+        def softcut_clear():
+            self._softcut_action(self.softcut.clear_outline)
+
+        @ctrl.trigger("vc_sc_preview")
+        def softcut_preview():
+            self._softcut_action(lambda: self.softcut.preview(state.vc_sc_depth), skin=True)
+
+        @ctrl.trigger("vc_sc_hide_preview")
+        def softcut_hide_preview():
+            self._softcut_action(self.softcut.clear_preview)
+
+        @ctrl.trigger("vc_sc_carve")
+        def softcut_carve():
+            self._softcut_action(lambda: self.softcut.carve(state.vc_sc_depth), skin=True, carve=True)
+
+        @ctrl.trigger("vc_sc_export")
+        def softcut_export():
+            try:
+                self.softcut.set_depth(state.vc_sc_depth)
+                path = self.softcut.export_stl()
+            except SessionError as error:
+                state.vc_sc_error = str(error)
+                return None
+            state.vc_sc_error = ""
+            return self.server.protocol.addAttachment(path.read_bytes())
+
+        @state.change("vc_sc_normal")
+        def softcut_normal_changed(vc_sc_normal, **_):
+            if vc_sc_normal != self.softcut.normal_mode:
+                self._softcut_action(lambda: self.softcut.set_normal_mode(vc_sc_normal))
+
+        @state.change("vc_sc_depth")
+        def softcut_depth_changed(vc_sc_depth, **_):
+            # The slider previews as it moves: the plan is reused, only the preview field is carved again.
+            if self.softcut.previewing:
+                self._softcut_action(lambda: self.softcut.preview(vc_sc_depth))
+
+        @state.change("vc_sc_skin")
+        def softcut_skin_changed(vc_sc_skin, **_):
+            self.softcut.show_skin(bool(vc_sc_skin))
+            if self.progressive is not None:
+                self.progressive.pointer_moved()
+
         @state.change("vc_mode")
         def mode_changed(vc_mode, **_):
             try:
                 self.drill.set_mode(vc_mode)
             except ValueError:
                 state.vc_mode = self.drill.mode
+            # The outline lies on the skin; drilling shows the bone.
+            if self.drill.mode == views.MODE_OUTLINE:
+                self.drill.set_glyph(placed=False)
+                state.vc_sc_skin = True
+            elif self.drill.mode in (views.MODE_DRILL, views.MODE_RESTORE):
+                state.vc_sc_skin = False
             self._update_mode_hint()
 
         @state.change("vc_depth")
@@ -568,6 +646,62 @@ class VolumeCuttingApp(TrameApp):
             if depth != vc_depth:
                 state.vc_depth = depth
             self._update_mode_hint()
+
+    # ------------------------------------------------------------------ SoftCut
+
+    def _on_outline_pick(self, point) -> None:
+        self._softcut_action(lambda: self.softcut.add_point(point))
+        self.state.flush()
+
+    def _softcut_action(self, action, skin: bool = False, carve: bool = False) -> None:
+        """Run a SoftCut step; its error (the logic's message) shows in the panel, and nothing changes."""
+        state = self.state
+        if not self.session.has_data:
+            state.vc_sc_error = "Load a CT first (Data panel)"
+            return
+        if skin:
+            state.vc_sc_skin = True
+            self.softcut.show_skin(True)
+        try:
+            action()
+            error = ""
+        except SessionError as failure:
+            error = str(failure)
+        if carve and not error:
+            self._refresh_tables()
+        self._refresh_softcut(error=error, carved=carve and not error)
+        self.progressive.pointer_moved()
+
+    def _refresh_softcut(self, error: str | None = None, carved: bool = False) -> None:
+        state, softcut = self.state, self.softcut
+        state.vc_sc_points = len(softcut.outline_points())
+        state.vc_sc_example = softcut.has_example_outline()
+        state.vc_sc_normal = softcut.normal_mode
+        state.vc_sc_previewing = softcut.previewing
+        units = {"mm3": "mm³", "mm2": "mm²"}
+        state.vc_sc_measurements = [{"name": name, "value": round(softcut.measurements[name][0], 1),
+                                     "unit": units.get(softcut.measurements[name][1], softcut.measurements[name][1])}
+                                    for name in SOFTCUT_MEASUREMENTS if name in softcut.measurements]
+        if carved:
+            state.vc_sc_status = f"Carved {softcut.depth_mm:g} mm deep (undo takes it back)"
+        elif softcut.previewing:
+            state.vc_sc_status = f"Preview at {softcut.depth_mm:g} mm"
+        else:
+            state.vc_sc_status = ""
+        if error is not None:
+            state.vc_sc_error = error
+        self._update_outline_model()
+        self._update_mode_hint()
+
+    def _update_outline_model(self) -> None:
+        """The outline's points and the line through them, drawn over the skin."""
+        if self._outline_model is None or self._outline_model.GetScene() is None:
+            self._outline_model = self.slicer_app.scene.AddNewNodeByClass("vtkMRMLModelNode", "SoftCut outline (drawn)")
+            self._outline_model.CreateDefaultDisplayNodes()
+            display = self._outline_model.GetDisplayNode()
+            display.SetColor(0.1, 0.75, 1.0)
+            display.SetVisibility2D(False)
+        self._outline_model.SetAndObservePolyData(self.softcut.outline_polydata())
 
     # ------------------------------------------------------------------ data
 
@@ -682,6 +816,8 @@ class VolumeCuttingApp(TrameApp):
                     v3.VBtn("Navigate", value=views.MODE_NAVIGATE, prepend_icon="mdi-rotate-3d-variant", raw_attrs=['data-testid="mode-navigate"'])
                     v3.VBtn("Drill", value=views.MODE_DRILL, prepend_icon="mdi-screw-machine-flat-top", raw_attrs=['data-testid="mode-drill"'])
                     v3.VBtn("Restore", value=views.MODE_RESTORE, prepend_icon="mdi-bandage", raw_attrs=['data-testid="mode-restore"'])
+                    v3.VBtn("SoftCut outline", value=views.MODE_OUTLINE, prepend_icon="mdi-vector-polygon",
+                            raw_attrs=['data-testid="mode-outline"'])
                 v3.VBtn(icon="mdi-undo", click="trigger('vc_undo')", disabled=("vc_undo_count === 0",), raw_attrs=['data-testid="undo"'])
                 v3.VBtn(icon="mdi-redo", click="trigger('vc_redo')", disabled=("vc_redo_count === 0",), raw_attrs=['data-testid="redo"'])
             with layout.drawer as drawer:
@@ -705,12 +841,13 @@ class VolumeCuttingApp(TrameApp):
                     v3.VBtn("Drill from this tab", color="primary", click="trigger('vc_take_over')", raw_attrs=['data-testid="take-over"'])
 
     def _panels(self) -> None:
-        with v3.VExpansionPanels(multiple=True, model_value=("vc_panels", ["data", "segments", "tool", "drill", "export"]),
+        with v3.VExpansionPanels(multiple=True, model_value=("vc_panels", ["data", "segments", "tool", "drill", "softcut", "export"]),
                                  variant="accordion"):
             self._data_panel()
             self._segments_panel()
             self._tool_panel()
             self._drill_panel()
+            self._softcut_panel()
             self._export_panel()
 
     def _data_panel(self) -> None:
@@ -808,6 +945,51 @@ class VolumeCuttingApp(TrameApp):
                          classes="text-body-2 text-error")
                 with html.Div(v_for="(c, i) in vc_contacts", key="i", classes="text-caption"):
                     html.Span("{{ c.name }}: {{ c.depth.toFixed(2) }} mm")
+
+    def _softcut_panel(self) -> None:
+        with v3.VExpansionPanel(value="softcut", title="SoftCut (soft-tissue resection)",
+                                raw_attrs=['data-testid="softcut-panel"']), v3.VExpansionPanelText():
+            html.Div("Outline the resection on the skin (SoftCut outline mode: click its points in order around it), "
+                     "set the depth, preview, carve.", classes="text-caption")
+            with html.Div(classes="d-flex flex-wrap ga-1 mt-1"):
+                v3.VBtn("Example cheek outline", v_if="vc_sc_example", size="small", variant="tonal",
+                        click="trigger('vc_sc_example')", raw_attrs=['data-testid="softcut-example"'])
+                v3.VBtn("Last point", prepend_icon="mdi-undo-variant", size="small", variant="text",
+                        disabled=("vc_sc_points === 0",), click="trigger('vc_sc_undo_point')",
+                        raw_attrs=['data-testid="softcut-undo-point"'])
+                v3.VBtn("Clear", size="small", variant="text", disabled=("vc_sc_points === 0",),
+                        click="trigger('vc_sc_clear')", raw_attrs=['data-testid="softcut-clear"'])
+            html.Div("Outline: {{ vc_sc_points }} points", classes="text-body-2 mt-1",
+                     raw_attrs=['data-testid="softcut-points"'])
+            with v3.VBtnToggle(v_model=("vc_sc_normal",), mandatory=True, density="compact", classes="mt-1",
+                               raw_attrs=['data-testid="softcut-normal"']):
+                for mode in NORMAL_MODES:
+                    v3.VBtn(f"{mode} normal", value=mode, size="small", raw_attrs=[f'data-testid="softcut-normal-{mode}"'])
+            v3.VSlider(v_model=("vc_sc_depth",), min=SOFTCUT_DEPTH_RANGE_MM[0], max=SOFTCUT_DEPTH_RANGE_MM[1],
+                       step=SOFTCUT_DEPTH_STEP_MM, label="Depth (mm)", thumb_label="always", density="compact",
+                       hide_details=True, classes="mt-6", raw_attrs=['data-testid="softcut-depth"'])
+            v3.VSwitch(v_model=("vc_sc_skin",), label="Show the skin", density="compact", hide_details=True,
+                       color="primary", raw_attrs=['data-testid="softcut-skin"'])
+            with html.Div(classes="d-flex ga-1"):
+                v3.VBtn("Preview", v_if="!vc_sc_previewing", size="small", variant="tonal", prepend_icon="mdi-eye",
+                        click="trigger('vc_sc_preview')", raw_attrs=['data-testid="softcut-preview"'])
+                v3.VBtn("Hide preview", v_else=True, size="small", variant="tonal", prepend_icon="mdi-eye-off",
+                        click="trigger('vc_sc_hide_preview')", raw_attrs=['data-testid="softcut-hide-preview"'])
+                v3.VBtn("Carve", size="small", color="primary", prepend_icon="mdi-content-cut",
+                        click="trigger('vc_sc_carve')", raw_attrs=['data-testid="softcut-carve"'])
+                v3.VBtn("STL", size="small", variant="tonal", prepend_icon="mdi-download",
+                        click="trigger('vc_sc_export').then((content) => content && "
+                              "utils.download(vc_sc_export_name, content, 'model/stl'))",
+                        raw_attrs=['data-testid="softcut-export"'])
+            html.Div("{{ vc_sc_status }}", classes="text-caption mt-1", raw_attrs=['data-testid="softcut-status"'])
+            with v3.VTable(v_if="vc_sc_measurements.length", density="compact", style="font-size: 13px",
+                           raw_attrs=['data-testid="softcut-measurements"']):
+                with html.Tbody():
+                    with html.Tr(v_for="m in vc_sc_measurements", key="m.name", raw_attrs=[':data-measurement="m.name"']):
+                        html.Td("{{ m.name }}", style="padding: 0 4px")
+                        html.Td("{{ m.value.toFixed(1) }} {{ m.unit }}", classes="text-right", style="padding: 0 4px")
+            v3.VAlert(v_if="vc_sc_error", text=("vc_sc_error",), type="error", density="compact", classes="mt-2",
+                      raw_attrs=['data-testid="softcut-error"'])
 
     def _export_panel(self) -> None:
         with v3.VExpansionPanel(value="export", title="Export"), v3.VExpansionPanelText():

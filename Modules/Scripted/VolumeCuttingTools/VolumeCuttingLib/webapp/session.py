@@ -19,7 +19,10 @@ so that it is tested without a browser:
 * tables: the removed volume per segment (the logic's table) and the
   deepest contact with a structure the tool may not cut;
 * exports: the removed region as STL and as a segmentation, the drilled CT,
-  and the scene as a Slicer bundle (.mrb).
+  and the scene as a Slicer bundle (.mrb);
+* SoftCut (``SoftCutSession``): a soft-tissue resection outlined on the skin,
+  previewed at a depth, carved as one undo step, measured and exported as
+  STL through ``vtkSlicerVolumeCuttingSoftCutLogic``.
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ import numpy as np
 import slicer
 import vtk
 
-from .. import headct, mainjob, owndata, phantom, toolconfig
+from .. import headct, mainjob, owndata, phantom, softcut, softcutjob, toolconfig
 from ..application import configure_scene_io
 
 ROLES = (toolconfig.ROLE_CUTTABLE, toolconfig.ROLE_PROTECTED, toolconfig.ROLE_NONE)
@@ -153,6 +156,7 @@ class DrillSession:
         self.cut_node = None
         self.tool_node = None
         self.description = ""
+        self.source = ""
         self.warnings: list[str] = []
         self._data_nodes: list = []
         self.action = None  # slicer.vtkSlicerVolumeCuttingLogic.ToolCut or ToolRestore inside a stroke
@@ -266,6 +270,7 @@ class DrillSession:
         self._data_nodes = list(dict.fromkeys(n for n in created if n is not None))
         self.volume, self.segmentation, self.bone_segmentation = volume, roles_segmentation, bone
         self.cut_node, self.tool_node, self.description = cut_node, tool, description
+        self.source = source
         self.warnings = warnings
         yield 1.0, "Ready"
 
@@ -509,3 +514,270 @@ class DrillSession:
         if self._temporary is not None:
             self._temporary.cleanup()
 
+
+
+# --------------------------------------------------------------------------- SoftCut
+
+NORMAL_MODES = {"local": slicer.vtkVolumeCutResectionPlanner.LocalNormal,
+                "average": slicer.vtkVolumeCutResectionPlanner.AverageNormal}
+# Depth of cut (mm): the slider's range and step; the plan reaches as deep as the slider.
+SOFTCUT_DEPTH_RANGE_MM = (0.5, 20.0)
+SOFTCUT_DEPTH_STEP_MM = 0.5
+SOFTCUT_DEFAULT_DEPTH_MM = softcutjob.DEPTH_MM
+# The panel's measurements, in the logic's table's names.
+SOFTCUT_MEASUREMENTS = ("Resected volume", "Surface area", "Length", "Width", "Thickness")
+
+
+class SoftCutSession:
+    """SoftCut on a drilling session's data: outline, normal mode, depth preview, carve, measurements, STL.
+
+    The outline is a closed markups curve whose control points the user
+    places on the skin (``add_point``, from a pick on the 3D view's
+    surface) or the main job's cheek outline on the example head CT
+    (``use_example_outline``). The plan is made when it is first needed
+    (preview, carve, measurements, STL) and again after the outline or the
+    normal mode changed. Bad input raises ``SessionError`` with the
+    logic's message and changes nothing already planned or carved.
+
+    While SoftCut is shown (``show_skin``) the cut node's surface is the skin
+    (-500 HU), so that the view shows and picks what the outline lies on.
+    """
+
+    def __init__(self, session: DrillSession):
+        self.session = session
+        self.logic = softcut.create_logic(_ApplicationLogics(session))
+        self.logic.SetSkinIsoValue(softcutjob.SKIN_ISO_HU)
+        self.logic.SetMaximumDepth(SOFTCUT_DEPTH_RANGE_MM[1])
+        self.normal_mode = "local"
+        self.depth_mm = SOFTCUT_DEFAULT_DEPTH_MM
+        self.outline = None
+        self.measurements: dict[str, tuple[float, str]] = {}
+        self._cut_node = None
+        self._planned = None  # (outline points, normal mode) of the plan the logic holds
+        self.previewing = False
+
+    # -- outline
+
+    def _sync(self) -> None:
+        """New data: the outline and plan of the old data go with it."""
+        if self.session.cut_node is self._cut_node:
+            return
+        if self.outline is not None and self.outline.GetScene() is not None:
+            owndata.remove_nodes(self.session.scene, self.outline)
+        self.outline, self._planned, self.measurements, self.previewing = None, None, {}, False
+        self._cut_node = self.session.cut_node
+
+    def outline_points(self) -> list[tuple[float, float, float]]:
+        self._sync()
+        if self.outline is None:
+            return []
+        points = []
+        for index in range(self.outline.GetNumberOfControlPoints()):
+            position = [0.0, 0.0, 0.0]
+            self.outline.GetNthControlPointPositionWorld(index, position)
+            points.append(tuple(position))
+        return points
+
+    def add_point(self, ras) -> int:
+        """Append a control point (RAS, picked on the skin); returns how many the outline has."""
+        self.session._require_data()
+        self._sync()
+        point = np.asarray(ras, dtype=float)
+        if point.shape != (3,) or not np.all(np.isfinite(point)):
+            raise SessionError(f"SoftCut outline point {ras!r} is not a point (three numbers, RAS mm)")
+        if self.outline is None:
+            self.outline = softcut.add_outline(self.session.scene, [point], name="SoftCut outline")
+            if self.outline.GetDisplayNode() is not None:
+                self.outline.GetDisplayNode().SetVisibility(False)  # the page draws its own outline
+            self.session._data_nodes.append(self.outline)
+        else:
+            self.outline.AddControlPointWorld(vtk.vtkVector3d(*point))
+        self._outline_changed()
+        return self.outline.GetNumberOfControlPoints()
+
+    def remove_last_point(self) -> int:
+        self._sync()
+        if self.outline is not None and self.outline.GetNumberOfControlPoints():
+            self.outline.RemoveNthControlPoint(self.outline.GetNumberOfControlPoints() - 1)
+            self._outline_changed()
+        return len(self.outline_points())
+
+    def clear_outline(self) -> None:
+        self._sync()
+        if self.outline is not None:
+            self.outline.RemoveAllControlPoints()
+            self._outline_changed()
+
+    def has_example_outline(self) -> bool:
+        return self.session.has_data and self.session.source == "headct"
+
+    def use_example_outline(self) -> int:
+        """The main job's right-cheek outline (softcutjob), picked on the head CT's skin; average normal."""
+        self.session._require_data()
+        if not self.has_example_outline():
+            raise SessionError("The example cheek outline is drawn on the example head CT: load it in the Data panel, "
+                               "or click the outline on the skin in SoftCut outline mode")
+        points = softcut.picked_points(self.session.volume, softcutjob.CHEEK_CENTER, -np.asarray(softcutjob.VIEW_DIRECTION),
+                                       softcutjob.CHEEK_RADII, count=softcutjob.CONTROL_POINTS, iso=softcutjob.SKIN_ISO_HU)
+        self.clear_outline()
+        for point in points:
+            self.add_point(point)
+        self.set_normal_mode("average")
+        return len(points)
+
+    def set_normal_mode(self, mode: str) -> None:
+        if mode not in NORMAL_MODES:
+            raise SessionError(f"SoftCut normal mode {mode!r} is not one of {', '.join(NORMAL_MODES)}")
+        if mode != self.normal_mode:
+            self.normal_mode = mode
+            self._outline_changed()
+
+    def _outline_changed(self) -> None:
+        # A plan of another outline must neither be previewed nor carved.
+        if self.previewing and self.session.has_data:
+            self.logic.ClearPreview(self.session.cut_node)
+        self.previewing = False
+        self.measurements = {}
+
+    # -- plan, preview, carve
+
+    def set_depth(self, depth_mm) -> float:
+        depth = float(depth_mm)
+        if not np.isfinite(depth) or not SOFTCUT_DEPTH_RANGE_MM[0] <= depth <= SOFTCUT_DEPTH_RANGE_MM[1]:
+            raise SessionError(f"SoftCut depth of cut {depth_mm!r} mm: give a depth between "
+                               f"{SOFTCUT_DEPTH_RANGE_MM[0]:g} and {SOFTCUT_DEPTH_RANGE_MM[1]:g} mm")
+        self.depth_mm = depth
+        return depth
+
+    def plan(self) -> None:
+        """Plan the resection of the current outline (again only when the outline or the normal mode changed)."""
+        self.session._require_data()
+        self._sync()
+        key = (tuple(self.outline_points()), self.normal_mode)
+        if self._planned == key and self.logic.GetPlanner(self.session.cut_node) is not None:
+            return
+        if self.outline is None or self.outline.GetNumberOfControlPoints() == 0:
+            raise SessionError("There is no SoftCut outline yet: click at least 3 points on the skin in SoftCut outline "
+                               "mode, or use the example cheek outline")
+        self.logic.SetNormalMode(NORMAL_MODES[self.normal_mode])
+        if not self.logic.PlanResection(self.session.cut_node, self.outline):
+            self._planned = None
+            raise SessionError(self.logic.GetErrorMessage())
+        self._planned = key
+
+    def preview(self, depth_mm=None) -> None:
+        """Show what a carve at the depth (mm; default the current one) would remove, in the 3D view."""
+        if depth_mm is not None:
+            self.set_depth(depth_mm)
+        self.plan()
+        if not self.logic.PreviewDepth(self.session.cut_node, self.depth_mm):
+            raise SessionError(self.logic.GetErrorMessage())
+        self.previewing = True
+
+    def clear_preview(self) -> None:
+        if self.session.has_data and self.previewing:
+            self.logic.ClearPreview(self.session.cut_node)
+        self.previewing = False
+
+    def carve(self, depth_mm=None) -> dict[str, tuple[float, str]]:
+        """Carve the resection at the depth into the cut (one undo step) and measure it; the measurements."""
+        if depth_mm is not None:
+            self.set_depth(depth_mm)
+        self.plan()
+        self.session.end_stroke()
+        if not self.logic.CarveResection(self.session.cut_node, self.depth_mm):
+            raise SessionError(self.logic.GetErrorMessage())
+        self.previewing = False
+        return self.measure()
+
+    def measure(self) -> dict[str, tuple[float, str]]:
+        """Volume, area and extents of the resected tissue at the current depth, {name: (value, unit)}."""
+        self.plan()
+        table = self.logic.MeasureResection(self.session.cut_node, self.depth_mm)
+        if table is None:
+            raise SessionError(self.logic.GetErrorMessage())
+        self.measurements = softcut.table_rows(table)
+        return self.measurements
+
+    def export_stl(self) -> Path:
+        """The resected tissue at the current depth as an STL (a harvesting guide), in the work folder."""
+        self.plan()
+        folder = self.session.work_directory / "exports"
+        folder.mkdir(parents=True, exist_ok=True)
+        base = "".join(c if c.isalnum() or c in "-_" else "_" for c in self.session.volume.GetName()) or "volume"
+        path = folder / f"{base}-resection.stl"
+        if not self.logic.ExportResectionToSTL(self.session.cut_node, self.depth_mm, str(path)):
+            raise SessionError(self.logic.GetErrorMessage())
+        return path
+
+    # -- view
+
+    SOFT_TISSUE_SEGMENT_ID = "SoftCutSoftTissue"
+
+    def show_skin(self, shown: bool) -> None:
+        """The 3D view's surface: the skin while SoftCut is used, the bone (and thin-bone shading) for drilling.
+
+        The view draws segments only: the skin shows through a cuttable
+        segment of the soft tissue (``softcutjob.soft_tissue_segment``),
+        added on first use, first in order so that bone wins where they
+        overlap, and hidden (still cuttable) for drilling.
+        """
+        if not self.session.has_data:
+            return
+        self._sync()
+        cut_node = self.session.cut_node
+        segmentation = self.session.segmentation
+        segment_id = self.SOFT_TISSUE_SEGMENT_ID
+        if shown and segmentation.GetSegmentation().GetSegment(segment_id) is None:
+            segmentation.GetSegmentation().AddSegment(
+                softcutjob.soft_tissue_segment(self.session.volume, "Skin and soft tissue (SoftCut)"), segment_id)
+            segmentation.GetSegmentation().SetSegmentIndex(segment_id, 0)
+            cut_node.SetCuttableSegmentIDs(list(cut_node.GetCuttableSegmentIDs()) + [segment_id])
+        was_modifying = cut_node.StartModify()
+        cut_node.SetSurfaceIsoValue(softcutjob.SKIN_ISO_HU if shown else SURFACE_ISO_HU)
+        cut_node.SetThinBoneShading(not shown)
+        cut_node.EndModify(was_modifying)
+        display = segmentation.GetDisplayNode()
+        if display is not None and segmentation.GetSegmentation().GetSegment(segment_id) is not None:
+            display.SetSegmentVisibility3D(segment_id, bool(shown))
+
+    def outline_polydata(self) -> vtk.vtkPolyData:
+        """The outline as the page draws it: a ball at each point and a tube through them (closed from 3 points)."""
+        points = self.outline_points()
+        append = vtk.vtkAppendPolyData()
+        empty = vtk.vtkPolyData()
+        append.AddInputData(empty)
+        for point in points:
+            ball = vtk.vtkSphereSource()
+            ball.SetCenter(*point)
+            ball.SetRadius(1.2)
+            ball.Update()
+            append.AddInputData(ball.GetOutput())
+        if len(points) >= 2:
+            line = vtk.vtkPolyData()
+            vtk_points = vtk.vtkPoints()
+            for point in points:
+                vtk_points.InsertNextPoint(*point)
+            ids = list(range(len(points))) + ([0] if len(points) >= 3 else [])
+            cells = vtk.vtkCellArray()
+            cells.InsertNextCell(len(ids))
+            for index in ids:
+                cells.InsertCellPoint(index)
+            line.SetPoints(vtk_points)
+            line.SetLines(cells)
+            tube = vtk.vtkTubeFilter()
+            tube.SetInputData(line)
+            tube.SetRadius(0.6)
+            tube.SetNumberOfSides(10)
+            tube.Update()
+            append.AddInputData(tube.GetOutput())
+        append.Update()
+        return append.GetOutput()
+
+
+class _ApplicationLogics:
+    """What ``softcut.create_logic`` reads of an application: the scene and the volume-cutting logic."""
+
+    def __init__(self, session: DrillSession):
+        self.scene = session.scene
+        self.volume_cutting_logic = session.logic

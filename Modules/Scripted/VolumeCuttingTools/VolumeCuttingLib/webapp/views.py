@@ -10,7 +10,8 @@
   in each 3D view. It draws the tool glyph at the tool's pose, over the
   anatomy (its own render layer, occluded by the bone in front of it), and,
   in the drill and restore modes, turns press-drag-release into a stroke of
-  the active tool along the surface under the mouse.
+  the active tool along the surface under the mouse; in the SoftCut outline
+  mode a click places a point of the outline on the surface under the mouse.
 
 Multisampling is off in every view: the images are the ray caster's and the
 resliced CT, drawn pixel for pixel (on llvmpipe 8x multisampling made a
@@ -131,10 +132,14 @@ class VolumeCutThreeDView(ThreeDView):
         """Look at the centre of ``bounds`` (RAS) from ``direction`` (towards the eye)."""
         center = [(bounds[2 * axis] + bounds[2 * axis + 1]) / 2.0 for axis in range(3)]
         extent = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
+        self.look_at(center, direction, distance_factor * extent, view_up)
+
+    def look_at(self, center, direction, distance, view_up=(0.0, 0.0, 1.0)) -> None:
+        """Look at ``center`` (RAS) from ``distance`` mm along ``direction`` (towards the eye)."""
         camera_node = self.get_camera_node()
         camera = camera_node.GetCamera() if camera_node is not None else self.renderer().GetActiveCamera()
         camera.SetFocalPoint(*center)
-        camera.SetPosition(*(c + distance_factor * extent * d for c, d in zip(center, direction)))
+        camera.SetPosition(*(c + distance * d for c, d in zip(center, direction)))
         camera.SetViewUp(*view_up)
         camera.SetViewAngle(30.0)
         self.renderer().ResetCameraClippingRange()
@@ -212,7 +217,10 @@ def tool_glyph(tool_node) -> vtk.vtkPolyData:
 MODE_NAVIGATE = "navigate"
 MODE_DRILL = "drill"
 MODE_RESTORE = "restore"
-MODES = (MODE_NAVIGATE, MODE_DRILL, MODE_RESTORE)
+MODE_OUTLINE = "outline"
+MODES = (MODE_NAVIGATE, MODE_DRILL, MODE_RESTORE, MODE_OUTLINE)
+# Events the SoftCut outline mode takes; the others (wheel, right and middle drags) move the camera.
+_OUTLINE_EVENTS = (int(vtk.vtkCommand.LeftButtonPressEvent), int(vtk.vtkCommand.LeftButtonReleaseEvent))
 
 # Depth of the tool's tip below the surface (mm): the wheel's step and the range.
 DEPTH_STEP_MM = 0.25
@@ -231,7 +239,8 @@ class DrillController:
 
     ``on_stroke_begin()`` / ``on_stroke_end()`` / ``on_stroke_moved()`` and
     ``on_depth_changed(depth)`` let the application refine rendering and
-    refresh its panels.
+    refresh its panels; ``on_outline_pick(point)`` receives the surface point
+    (RAS) clicked in the SoftCut outline mode.
     """
 
     def __init__(self, session):
@@ -243,6 +252,7 @@ class DrillController:
         self.on_stroke_end = lambda: None
         self.on_hover = lambda: None
         self.on_depth_changed = lambda depth: None
+        self.on_outline_pick = lambda point: None
         # Where the surface under the mouse is read: the views' SurfaceDepth (the freshest is used).
         self.depth_sources = lambda: []
         # Whether the tool is over the surface (its glyph shows in every view) and touches a structure it may not cut.
@@ -374,9 +384,13 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
     def CanProcessInteractionEvent(self, event_data):
         if self.controller.mode == MODE_NAVIGATE or not self.controller.session.has_data:
             return False, 1e30
+        if self.controller.mode == MODE_OUTLINE:
+            return int(event_data.GetType()) in _OUTLINE_EVENTS, 0.0
         return int(event_data.GetType()) in self._events, 0.0
 
     def ProcessInteractionEvent(self, event_data) -> bool:
+        if self.controller.mode == MODE_OUTLINE:
+            return self._on_outline_event(event_data)
         handler = self._events.get(int(event_data.GetType()))
         return bool(handler(event_data)) if handler is not None else False
 
@@ -413,6 +427,16 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         session = self.controller.session
         pose = tool_pose(point, direction, depth_mm, session.tool_reach(), camera.GetViewUp())
         return pose, np.array([pose.GetElement(r, 3) for r in range(3)])
+
+    def _on_outline_event(self, event_data) -> bool:
+        """SoftCut outline mode: a press on the surface places a point there (the release has nothing to do)."""
+        if int(event_data.GetType()) != int(vtk.vtkCommand.LeftButtonPressEvent):
+            return True
+        source = self._depth_source()
+        hit = source.surface_point(*self._fraction(event_data)) if source is not None else None
+        if hit is not None:
+            self.controller.on_outline_pick(hit[0])
+        return True
 
     def _stroke_depth_mm(self, event_data) -> float:
         depth = self.controller.depth_mm
