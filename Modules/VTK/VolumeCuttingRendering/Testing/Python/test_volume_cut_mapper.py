@@ -113,6 +113,17 @@ def render_window(width, height=None):
     return window, renderer
 
 
+def render_on_both_paths(window, mapper, width):
+    """The window's depth and colour drawn by the CPU path, then by the GPU path, keyed by path."""
+    images = {}
+    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
+        mapper.SetRequestedRenderPath(path)
+        window.Render()
+        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+        images[path] = read_window(window, width)
+    return images
+
+
 def add_cut_volume(scene, intensities, cut, renderer):
     mapper = vc.vtkVolumeCutVolumeMapper()
     mapper.SetInputData(intensities)
@@ -144,12 +155,7 @@ def test_gpu_and_cpu_paths_draw_the_same_image(scene, intensities):
     window, renderer = render_window(width)
     renderer.SetActiveCamera(A.make_camera(scene, 8.0, width, width))
     mapper, _ = add_cut_volume(scene, intensities, cut, renderer)
-    images = {}
-    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-        mapper.SetRequestedRenderPath(path)
-        window.Render()
-        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-        images[path] = read_window(window, width)
+    images = render_on_both_paths(window, mapper, width)
     cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
     gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
     # Stated tolerance: depth within 1e-4 of the window range, colour within
@@ -530,12 +536,7 @@ def test_gpu_path_draws_fractional_segments_like_the_cpu(scene, intensities, wit
         caster.SetLabelMap(binary)  # label 1 everywhere the ball is; the fraction overrides it
     caster.SetSegmentFraction(1, fraction)
     caster.SetSegmentAppearance(1, (0.2, 0.6, 0.9), 1.0, float("nan"))
-    images = {}
-    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-        mapper.SetRequestedRenderPath(path)
-        window.Render()
-        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-        images[path] = read_window(window, width)
+    images = render_on_both_paths(window, mapper, width)
     cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
     gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
     assert np.any(cpu_depth < 1.0)
@@ -603,12 +604,7 @@ def test_surface_shows_the_segment_of_the_material_behind_it():
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     renderer.AddVolume(volume)
-    images = {}
-    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-        mapper.SetRequestedRenderPath(path)
-        window.Render()
-        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-        images[path] = read_window(window, width)
+    images = render_on_both_paths(window, mapper, width)
     owners = image_array(caster.GetSegmentImage, width, width, 1)
     surface = owners > 0
     assert surface.sum() > 0.15 * width * width
@@ -654,12 +650,7 @@ def test_segments_of_one_material_share_their_surface_colour_and_cuts_tell_them_
     caster.SetSegmentAppearance(1, cortex, 1.0, scene.iso_value())
     caster.SetSegmentAppearance(2, cancellous, 1.0, scene.iso_value())
     caster.SetSegmentSurfaceColor(2, cortex)
-    images = {}
-    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-        mapper.SetRequestedRenderPath(path)
-        window.Render()
-        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-        images[path] = read_window(window, width)
+    images = render_on_both_paths(window, mapper, width)
     sources = image_array(caster.GetSourceImage, width, width, 1)
     owners = image_array(caster.GetSegmentImage, width, width, 1)
     rgba = image_array(caster.GetColorImage, width, width, 4)
@@ -731,12 +722,7 @@ def test_gpu_path_draws_ambient_occlusion_like_the_cpu(scene, intensities):
     renderer.SetActiveCamera(A.make_camera(scene, 1.0, width, width))
     mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(2), renderer)
     mapper.GetRayCaster().SetAmbientOcclusion(True)
-    images = {}
-    for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-        mapper.SetRequestedRenderPath(path)
-        window.Render()
-        assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-        images[path] = read_window(window, width)
+    images = render_on_both_paths(window, mapper, width)
     cpu_depth, cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath]
     gpu_depth, gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath]
     assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
@@ -775,12 +761,7 @@ def test_binary_segments_are_smoothed_between_slices(scene, intensities):
         volume = vtk.vtkVolume()
         volume.SetMapper(mapper)
         renderer.AddVolume(volume)
-        images = {}
-        for path in (vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath):
-            mapper.SetRequestedRenderPath(path)
-            window.Render()
-            assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-            images[path] = read_window(window, width)
+        images = render_on_both_paths(window, mapper, width)
         cpu_depth, gpu_depth = images[vc.vtkVolumeCutVolumeMapper.CPUPath][0], images[vc.vtkVolumeCutVolumeMapper.GPUPath][0]
         assert np.array_equal(cpu_depth < 1.0, gpu_depth < 1.0)
         assert np.max(np.abs(cpu_depth - gpu_depth)) < 1e-4
