@@ -11,8 +11,9 @@
  * volume's box and the clip planes analytically, as the ray's entry and
  * exit. Where a border could hide between two samples that agree (a grazing
  * ray over an edge), MayHideBorders decides from a Lipschitz bound: the CT's
- * largest gradient in the 8^3 block (vtkVolumeCutEmptySpace), or the cut
- * field being a distance.
+ * largest gradient in the 8^3 block (vtkVolumeCutEmptySpace), then the
+ * exact maximum of the trilinear CT along the interval, or the cut field
+ * being a distance.
  *
  * @sa vtkVolumeCutSampleClassifier (step 1) vtkVolumeCutPieceClassifier (step 3)
  */
@@ -214,7 +215,14 @@ public:
         return false;
       }
       const double slope = std::max(this->Scene.EmptySpace.Lipschitz(a.Index), this->Scene.EmptySpace.Lipschitz(b.Index));
-      return 0.5 * (double(a.Value) + double(b.Value) + slope * lengthVoxels) >= this->Scene.MinimumIso;
+      if (0.5 * (double(a.Value) + double(b.Value) + slope * lengthVoxels) < this->Scene.MinimumIso)
+      {
+        return false;
+      }
+      // The block's gradient bound is loose beside bone, where it would have
+      // every step split; the exact maximum of the trilinear CT along the
+      // interval settles those.
+      return this->Classifier.Reaches(a.Index, b.Index, static_cast<float>(this->Scene.MinimumIso));
     }
     if (!a.CutsKnown || !b.CutsKnown)
     {

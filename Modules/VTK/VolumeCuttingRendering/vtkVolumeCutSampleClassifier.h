@@ -22,6 +22,8 @@
 #include "vtkVolumeCutField.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 /// One point of a ray and what is there.
 struct vtkVolumeCutSample
@@ -63,6 +65,139 @@ public:
       base[axis] = std::min(static_cast<int>(x), this->Scene.Dimensions[axis] - 2);
       f[axis] = x - base[axis];
     }
+  }
+
+  /**
+   * The largest CT value at the corners of the cells that the box from p to
+   * q touches: no trilinear value on the segment pq exceeds it.
+   */
+  float MaximumAround(const double p[3], const double q[3]) const
+  {
+    int low[3], high[3];
+    double f[3];
+    this->CellOf(p, low, f);
+    this->CellOf(q, high, f);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      if (low[axis] > high[axis])
+      {
+        std::swap(low[axis], high[axis]);
+      }
+    }
+    const vtkIdType sy = this->Scene.Dimensions[0];
+    const vtkIdType sz = static_cast<vtkIdType>(this->Scene.Dimensions[0]) * this->Scene.Dimensions[1];
+    float maximum = -std::numeric_limits<float>::infinity();
+    for (int k = low[2]; k <= high[2] + 1; ++k)
+    {
+      for (int j = low[1]; j <= high[1] + 1; ++j)
+      {
+        const float* row = this->Scene.Values.data() + j * sy + k * sz;
+        for (int i = low[0]; i <= high[0] + 1; ++i)
+        {
+          maximum = std::max(maximum, row[i]);
+        }
+      }
+    }
+    return maximum;
+  }
+
+  /**
+   * Whether the trilinear CT value reaches \a level somewhere on the segment
+   * from p to q (IJK). Exact up to rounding: in each cell the segment
+   * crosses, the value along it is a cubic in the ray parameter, whose
+   * maximum lies at an end of the piece or where its derivative vanishes.
+   */
+  bool Reaches(const double p[3], const double q[3], float level) const
+  {
+    if (this->MaximumAround(p, q) < level)
+    {
+      return false;
+    }
+    double d[3];
+    // Cell walls the segment crosses split it into pieces, one cell each.
+    double cuts[8] = { 0.0, 1.0 };
+    int count = 2;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      d[axis] = q[axis] - p[axis];
+      if (std::abs(d[axis]) < 1e-12)
+      {
+        continue;
+      }
+      const double from = std::min(p[axis], q[axis]);
+      const double to = std::max(p[axis], q[axis]);
+      for (double wall = std::floor(from) + 1.0; wall < to && count < 8; wall += 1.0)
+      {
+        cuts[count++] = (wall - p[axis]) / d[axis];
+      }
+    }
+    std::sort(cuts, cuts + count);
+    const vtkIdType sy = this->Scene.Dimensions[0];
+    const vtkIdType sz = static_cast<vtkIdType>(this->Scene.Dimensions[0]) * this->Scene.Dimensions[1];
+    for (int piece = 0; piece + 1 < count; ++piece)
+    {
+      const double t0 = cuts[piece];
+      const double t1 = cuts[piece + 1];
+      if (!(t1 > t0))
+      {
+        continue;
+      }
+      const double middle[3] = { p[0] + 0.5 * (t0 + t1) * d[0], p[1] + 0.5 * (t0 + t1) * d[1], p[2] + 0.5 * (t0 + t1) * d[2] };
+      int base[3];
+      double f[3];
+      this->CellOf(middle, base, f);
+      const float* v = this->Scene.Values.data() + base[0] + base[1] * sy + base[2] * sz;
+      // Trilinear value as A + Bx + Cy + Dz + Exy + Fxz + Gyz + Hxyz.
+      const double A = v[0];
+      const double B = v[1] - v[0];
+      const double C = v[sy] - v[0];
+      const double D = v[sz] - v[0];
+      const double E = v[sy + 1] - v[sy] - v[1] + v[0];
+      const double F = v[sz + 1] - v[sz] - v[1] + v[0];
+      const double G = v[sz + sy] - v[sz] - v[sy] + v[0];
+      const double H = v[sz + sy + 1] - v[sz + sy] - v[sz + 1] - v[sy + 1] + v[sz] + v[sy] + v[1] - v[0];
+      // Local coordinates along the piece: x = x0 + t dx (t is the segment's parameter).
+      const double x0 = p[0] - base[0], y0 = p[1] - base[1], z0 = p[2] - base[2];
+      const double dx = d[0], dy = d[1], dz = d[2];
+      const double k0 = A + B * x0 + C * y0 + D * z0 + E * x0 * y0 + F * x0 * z0 + G * y0 * z0 + H * x0 * y0 * z0;
+      const double k1 = B * dx + C * dy + D * dz + E * (x0 * dy + y0 * dx) + F * (x0 * dz + z0 * dx) + G * (y0 * dz + z0 * dy) +
+        H * (dx * y0 * z0 + x0 * dy * z0 + x0 * y0 * dz);
+      const double k2 = E * dx * dy + F * dx * dz + G * dy * dz + H * (dx * dy * z0 + dx * y0 * dz + x0 * dy * dz);
+      const double k3 = H * dx * dy * dz;
+      auto value = [&](double t) { return k0 + t * (k1 + t * (k2 + t * k3)); };
+      // A margin of a millionth of the level's scale covers rounding.
+      const double margin = 1e-6 * (std::abs(double(level)) + 1.0);
+      if (value(t0) + margin >= level || value(t1) + margin >= level)
+      {
+        return true;
+      }
+      // Stationary points: roots of k1 + 2 k2 t + 3 k3 t^2.
+      double roots[2];
+      int found = 0;
+      const double a2 = 3.0 * k3, a1 = 2.0 * k2, a0 = k1;
+      if (std::abs(a2) > 1e-300)
+      {
+        const double discriminant = a1 * a1 - 4.0 * a2 * a0;
+        if (discriminant >= 0.0)
+        {
+          const double root = std::sqrt(discriminant);
+          roots[found++] = (-a1 - root) / (2.0 * a2);
+          roots[found++] = (-a1 + root) / (2.0 * a2);
+        }
+      }
+      else if (std::abs(a1) > 1e-300)
+      {
+        roots[found++] = -a0 / a1;
+      }
+      for (int r = 0; r < found; ++r)
+      {
+        if (roots[r] > t0 && roots[r] < t1 && value(roots[r]) + margin >= level)
+        {
+          return true;
+        }
+      }
+    }
+    return false;
   }
 
   /// The CT value at p (trilinear).

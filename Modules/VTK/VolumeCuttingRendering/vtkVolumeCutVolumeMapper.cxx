@@ -5,6 +5,7 @@
 #include "vtkVolumeCutOpenGLRayCaster.h"
 #include "vtkVolumeCutRayCaster.h"
 
+#include <vtkCallbackCommand.h>
 #include <vtkColorTransferFunction.h>
 #include <vtkImageData.h>
 #include <vtkInformation.h>
@@ -27,6 +28,7 @@
 #include <vtkTimerLog.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
+#include <vtkWeakPointer.h>
 #include <vtk_glad.h>
 
 #include <algorithm>
@@ -75,6 +77,55 @@ struct vtkVolumeCutVolumeMapper::Internals
   // Measured cost of a CPU frame per ray cast (drawing included), 0 before
   // the first: what an interactive frame's resolution is chosen from.
   double SecondsPerRay = 0.0;
+  // What the window's frame costs besides this mapper (clearing, other
+  // props, compositing and swapping): an interactive frame leaves it its
+  // share of the time the window allows.
+  double RestOfFrame = 0.0;
+  double WindowFrameStart = 0.0;
+  double MapperTimeInFrame = 0.0;
+  vtkWeakPointer<vtkRenderWindow> TimedWindow;
+  unsigned long FrameStartTag = 0;
+  unsigned long FrameEndTag = 0;
+
+  void TimeFramesOf(vtkRenderWindow* window)
+  {
+    if (window == this->TimedWindow)
+    {
+      return;
+    }
+    this->StopTimingFrames();
+    this->TimedWindow = window;
+    this->RestOfFrame = 0.0;
+    this->MapperTimeInFrame = -1.0;
+    vtkNew<vtkCallbackCommand> start;
+    start->SetClientData(this);
+    start->SetCallback([](vtkObject*, unsigned long, void* clientData, void*) {
+      Internals* self = static_cast<Internals*>(clientData);
+      self->WindowFrameStart = vtkTimerLog::GetUniversalTime();
+      self->MapperTimeInFrame = -1.0;
+    });
+    vtkNew<vtkCallbackCommand> end;
+    end->SetClientData(this);
+    end->SetCallback([](vtkObject*, unsigned long, void* clientData, void*) {
+      Internals* self = static_cast<Internals*>(clientData);
+      if (self->MapperTimeInFrame >= 0.0)
+      {
+        self->RestOfFrame = std::max(0.0, vtkTimerLog::GetUniversalTime() - self->WindowFrameStart - self->MapperTimeInFrame);
+      }
+    });
+    this->FrameStartTag = window->AddObserver(vtkCommand::StartEvent, start);
+    this->FrameEndTag = window->AddObserver(vtkCommand::EndEvent, end);
+  }
+
+  void StopTimingFrames()
+  {
+    if (this->TimedWindow)
+    {
+      this->TimedWindow->RemoveObserver(this->FrameStartTag);
+      this->TimedWindow->RemoveObserver(this->FrameEndTag);
+    }
+    this->TimedWindow = nullptr;
+  }
   int ReportedPath = 0;
   bool ReportedNoInput = false;
   vtkOpenGLRenderWindow* Context = nullptr;
@@ -110,6 +161,7 @@ vtkVolumeCutVolumeMapper::vtkVolumeCutVolumeMapper()
 //------------------------------------------------------------------------------
 vtkVolumeCutVolumeMapper::~vtkVolumeCutVolumeMapper()
 {
+  this->Impl->StopTimingFrames();
   if (this->Impl->Context)
   {
     this->Impl->Release(this->Impl->Context);
@@ -297,6 +349,7 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   this->LastRenderPath = path;
   this->LastImageSampleDistance = sampleDistance;
   this->LastFrameTime = vtkTimerLog::GetUniversalTime() - start;
+  impl.MapperTimeInFrame = this->LastFrameTime;
   if (path == CPUPath && caster->GetNumberOfRaysCast() > 0 && !caster->GetLastRenderWasLocalized())
   {
     impl.SecondsPerRay = this->LastFrameTime / static_cast<double>(caster->GetNumberOfRaysCast());
@@ -304,9 +357,17 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
 }
 
 //------------------------------------------------------------------------------
+double vtkVolumeCutVolumeMapper::GetRestOfFrameTime() const
+{
+  return this->Impl->RestOfFrame;
+}
+
+//------------------------------------------------------------------------------
 int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, int width, int height)
 {
-  const double rate = renderer->GetRenderWindow()->GetDesiredUpdateRate();
+  vtkRenderWindow* window = renderer->GetRenderWindow();
+  this->Impl->TimeFramesOf(window);
+  const double rate = window->GetDesiredUpdateRate();
   if (this->MaximumImageSampleDistance <= 1 || rate < this->InteractiveUpdateRate)
   {
     return 1;
@@ -316,10 +377,14 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
     // No frame measured yet: the coarsest, so that the first motion responds.
     return this->MaximumImageSampleDistance;
   }
+  // The rest of the window's frame takes its time first; the mapper keeps
+  // at least a fifth of the frame, so that a slow window does not leave it
+  // nothing but the coarsest image.
+  const double allowed = std::max(0.2 / rate, 1.0 / rate - this->Impl->RestOfFrame);
   // Rays cost about the same each, so the distance goes with the square root
   // of the full frame's time over the time allowed.
   const double fullFrame = this->Impl->SecondsPerRay * width * height;
-  const int distance = static_cast<int>(std::ceil(std::sqrt(fullFrame * rate)));
+  const int distance = static_cast<int>(std::ceil(std::sqrt(fullFrame / allowed)));
   return std::max(1, std::min(this->MaximumImageSampleDistance, distance));
 }
 

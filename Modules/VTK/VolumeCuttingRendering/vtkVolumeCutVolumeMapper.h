@@ -31,8 +31,9 @@
  * displayable manager raises it while a stroke is drawn). An interactive
  * CPU frame casts one ray per ImageSampleDistance x ImageSampleDistance
  * pixels, the distance chosen from the measured cost of a ray so that the
- * frame fits in 1 / DesiredUpdateRate, without ambient occlusion; the
- * image is magnified. The first
+ * window's whole frame fits in 1 / DesiredUpdateRate (the rest of the
+ * frame, measured between the window's StartEvent and EndEvent, is taken
+ * off first), without ambient occlusion; the image is magnified. The first
  * still render (the rate lowered again when the motion stops) casts every
  * pixel and is the same image as a render that never interacted.
  *
@@ -92,6 +93,13 @@ public:
 
   /// Seconds the last frame took in this mapper (ray casting and drawing).
   vtkGetMacro(LastFrameTime, double);
+
+  /**
+   * Seconds the render window's last frame took besides this mapper (0
+   * before one was timed): what an interactive CPU frame leaves the rest of
+   * the window.
+   */
+  double GetRestOfFrameTime() const;
 
   ///@{
   /**
