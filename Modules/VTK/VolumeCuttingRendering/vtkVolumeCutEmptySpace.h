@@ -39,9 +39,21 @@ public:
   /// Bound of the CT's gradient (CT units per voxel) in the block holding p.
   float Lipschitz(const double p[3]) const { return this->GradientBound[this->BlockOf(p)]; }
 
-  /// Ray parameter where the ray (direction d in voxels) leaves the block holding p.
+  /**
+   * Ray parameter where the ray (direction d in voxels) leaves the empty
+   * region around the block holding p: the cube of blocks that are all
+   * empty, as far as the nearest occupied block allows (one block where an
+   * occupied one touches it). Rays through air cross it in one jump.
+   */
   double Exit(const double p[3], const double d[3], double t) const
   {
+    int b[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      b[axis] = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->Dimensions[axis] - 1);
+    }
+    const int reach = this->Reach[b[0] + this->Dimensions[0] * (b[1] + static_cast<vtkIdType>(this->Dimensions[1]) * b[2])];
+    const int margin = std::max(reach - 1, 0);
     double exit = std::numeric_limits<double>::infinity();
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -49,8 +61,7 @@ public:
       {
         continue;
       }
-      const int b = std::min(std::max(static_cast<int>(p[axis]) / BlockSize, 0), this->Dimensions[axis] - 1);
-      const double wall = d[axis] > 0.0 ? double((b + 1) * BlockSize) : double(b * BlockSize);
+      const double wall = d[axis] > 0.0 ? double((b[axis] + 1 + margin) * BlockSize) : double((b[axis] - margin) * BlockSize);
       exit = std::min(exit, t + (wall - p[axis]) / d[axis]);
     }
     return exit;
@@ -71,8 +82,13 @@ private:
     return b[0] + this->Dimensions[0] * (b[1] + this->Dimensions[1] * b[2]);
   }
 
+  /// Chessboard distance in blocks to the nearest occupied block (0 for an
+  /// occupied one, at most 255).
+  void ComputeReach();
+
   int Dimensions[3] = { 0, 0, 0 };
   std::vector<uint8_t> Occupied;
+  std::vector<uint8_t> Reach;
   std::vector<float> GradientBound;
 };
 

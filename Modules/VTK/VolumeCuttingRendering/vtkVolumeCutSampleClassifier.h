@@ -301,6 +301,24 @@ public:
   int DominantLabel(const double p[3], double& weight) const
   {
     const vtkVolumeCutRayScene& scene = this->Scene;
+    if (scene.Fractions.empty() && !scene.Labels.empty())
+    {
+      // Most cells lie inside one segment or in the background: all eight
+      // corners agree, and so does every weighing below.
+      int base[3];
+      double f[3];
+      this->CellOf(p, base, f);
+      const vtkIdType sy = scene.Dimensions[0];
+      const vtkIdType sz = static_cast<vtkIdType>(scene.Dimensions[0]) * scene.Dimensions[1];
+      const uint16_t* l = scene.Labels.data() + base[0] + base[1] * sy + base[2] * sz;
+      const uint16_t label = l[0];
+      if (l[1] == label && l[sy] == label && l[sy + 1] == label && l[sz] == label && l[sz + 1] == label && l[sz + sy] == label &&
+        l[sz + sy + 1] == label)
+      {
+        weight = label == 0 ? 0.0 : 1.0;
+        return label;
+      }
+    }
     double unlabelledBright = 0.0;
     const int best = this->StrongestLabel(
       p,
