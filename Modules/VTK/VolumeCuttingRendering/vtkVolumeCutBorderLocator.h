@@ -7,7 +7,8 @@
  *
  * Between two samples whose classes differ, each volume's border is located
  * on its own: bisection on the object class (vtkVolumeCutSampleClassifier)
- * and on each cut field's distance (22 steps, 1e-7 of the interval); the
+ * (16 halvings) and on each cut field's distance (Illinois regula falsi, at
+ * most 22 steps, to 2e-7 of the interval); the
  * volume's box and the clip planes analytically, as the ray's entry and
  * exit. Where a border could hide between two samples that agree (a grazing
  * ray over an edge), MayHideBorders decides from a Lipschitz bound: the CT's
@@ -53,7 +54,11 @@ struct vtkVolumeCutRay
 class vtkVolumeCutBorderLocator
 {
 public:
-  static constexpr int ObjectBisections = 22;
+  /// Halvings of a sample interval (0.5 voxel) for an object's border: 8e-6
+  /// voxel, finer than the GPU's single-precision ray parameter resolves.
+  static constexpr int ObjectBisections = 16;
+  /// At most this many steps for a cut field's border; the field is a
+  /// distance, so its zero is found by regula falsi in a few.
   static constexpr int CutBisections = 22;
   /// Intervals where a border may hide are split into 2^MaximumRefinements.
   static constexpr int MaximumRefinements = 4;
@@ -160,10 +165,20 @@ public:
     const vtkVolumeCutField* field = this->Scene.CutFields[n];
     double lo = a.T;
     double hi = b.T;
-    const bool loRemoved = a.Distance[n] < 0.0;
-    for (int iteration = 0; iteration < CutBisections; ++iteration)
+    double distanceLo = a.Distance[n];
+    double distanceHi = b.Distance[n];
+    const bool loRemoved = distanceLo < 0.0;
+    // Illinois regula falsi: the bracket always holds the border, and the
+    // end that stays put has its distance halved so that both ends move.
+    const double resolved = (hi - lo) * std::ldexp(1.0, -CutBisections);
+    int keptEnd = 0;
+    for (int iteration = 0; iteration < CutBisections && hi - lo > resolved; ++iteration)
     {
-      const double t = 0.5 * (lo + hi);
+      double t = distanceHi != distanceLo ? (lo * distanceHi - hi * distanceLo) / (distanceHi - distanceLo) : 0.5 * (lo + hi);
+      if (!(t > lo && t < hi))
+      {
+        t = 0.5 * (lo + hi);
+      }
       double index[3];
       double world[3];
       for (int axis = 0; axis < 3; ++axis)
@@ -171,7 +186,25 @@ public:
         index[axis] = ray.Origin[axis] + t * ray.Direction[axis];
       }
       this->Classifier.WorldPoint(index, world);
-      ((field->GetSignedDistance(world) < 0.0) == loRemoved ? lo : hi) = t;
+      const double distance = field->GetSignedDistance(world);
+      if (distance == 0.0 || std::abs(distance) < 1e-9)
+      {
+        return t;
+      }
+      if ((distance < 0.0) == loRemoved)
+      {
+        lo = t;
+        distanceLo = distance;
+        distanceHi *= keptEnd == 1 ? 0.5 : 1.0;
+        keptEnd = 1;
+      }
+      else
+      {
+        hi = t;
+        distanceHi = distance;
+        distanceLo *= keptEnd == -1 ? 0.5 : 1.0;
+        keptEnd = -1;
+      }
     }
     return 0.5 * (lo + hi);
   }

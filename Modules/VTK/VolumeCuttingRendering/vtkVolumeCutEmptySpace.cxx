@@ -5,6 +5,8 @@
 #include "vtkVolumeCutParallelFor.h"
 #include "vtkVolumeCutRayScene.h"
 
+#include <cmath>
+
 //------------------------------------------------------------------------------
 void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximumThreads)
 {
@@ -141,6 +143,103 @@ void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximu
     }
   });
   this->ComputeReach();
+  this->BuildCells(scene, maximumThreads);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int maximumThreads)
+{
+  this->CellBits.clear();
+  const int* dims = scene.Dimensions;
+  if (scene.BlendMode == 1 || dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
+  {
+    return; // composite: every opacity counts; one slice: no cells
+  }
+  const std::vector<vtkVolumeCutRayScene::SegmentStyle>& styles = scene.Styles;
+  constexpr float Never = std::numeric_limits<float>::infinity();
+  constexpr float Always = -std::numeric_limits<float>::infinity();
+  // The lowest CT value at which a voxel's segment is visible there: a
+  // shape-defined segment always, an iso-defined one at its iso-value, a
+  // hidden segment or the background never.
+  auto visibleFrom = [&](int label) -> float {
+    if (label <= 0 || label >= static_cast<int>(styles.size()) || styles[label].Opacity <= 0.f)
+    {
+      return Never;
+    }
+    return styles[label].Shape ? Always : styles[label].Iso;
+  };
+  const bool segments = scene.HasSegments();
+  const float unsegmented = segments ? Never : visibleFrom(1);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    this->CellDimensions[axis] = dims[axis] - 1;
+  }
+  const int cx = this->CellDimensions[0];
+  const int cy = this->CellDimensions[1];
+  this->WordsPerCellLayer = (static_cast<size_t>(cx) * cy + 63) / 64;
+  this->CellBits.assign(this->WordsPerCellLayer * this->CellDimensions[2], 0);
+  const vtkIdType sliceSize = static_cast<vtkIdType>(dims[0]) * dims[1];
+  vtkVolumeCutParallelFor(maximumThreads, this->CellDimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+    // Per slice, the largest value and the lowest visibility of each 2 x 2
+    // group of voxels; a cell takes those of its two slices.
+    std::vector<float> high[2], low[2];
+    auto reduceSlice = [&](int k, std::vector<float>& sliceHigh, std::vector<float>& sliceLow) {
+      sliceHigh.assign(static_cast<size_t>(cx) * cy, 0.f);
+      sliceLow.assign(static_cast<size_t>(cx) * cy, Never);
+      std::vector<float> needed(static_cast<size_t>(sliceSize));
+      const vtkIdType offset = sliceSize * k;
+      for (vtkIdType v = 0; v < sliceSize; ++v)
+      {
+        needed[v] = segments && !scene.Labels.empty() ? visibleFrom(scene.Labels[offset + v]) : unsegmented;
+      }
+      for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
+      {
+        const float from = visibleFrom(fraction.Label);
+        for (vtkIdType v = 0; v < sliceSize; ++v)
+        {
+          if (fraction.Values[offset + v] > 0.f)
+          {
+            needed[v] = std::min(needed[v], from);
+          }
+        }
+      }
+      const float* values = scene.Values.data() + offset;
+      for (int j = 0; j < cy; ++j)
+      {
+        for (int i = 0; i < cx; ++i)
+        {
+          const vtkIdType v = i + static_cast<vtkIdType>(dims[0]) * j;
+          const vtkIdType corners[4] = { v, v + 1, v + dims[0], v + dims[0] + 1 };
+          float h = values[corners[0]];
+          float l = needed[corners[0]];
+          for (int c = 1; c < 4; ++c)
+          {
+            h = std::max(h, values[corners[c]]);
+            l = std::min(l, needed[corners[c]]);
+          }
+          // NaN voxels: the cell is kept, as every path treats it alike.
+          sliceHigh[i + static_cast<size_t>(cx) * j] = std::isnan(h) ? std::numeric_limits<float>::infinity() : h;
+          sliceLow[i + static_cast<size_t>(cx) * j] = l;
+        }
+      }
+    };
+    reduceSlice(static_cast<int>(beginZ), high[0], low[0]);
+    for (vtkIdType k = beginZ; k < endZ; ++k)
+    {
+      const int current = static_cast<int>(k - beginZ) % 2;
+      reduceSlice(static_cast<int>(k) + 1, high[1 - current], low[1 - current]);
+      uint64_t* layer = this->CellBits.data() + static_cast<size_t>(k) * this->WordsPerCellLayer;
+      for (size_t cell = 0; cell < static_cast<size_t>(cx) * cy; ++cell)
+      {
+        const float h = std::max(high[0][cell], high[1][cell]);
+        const float l = std::min(low[0][cell], low[1][cell]);
+        if (h >= l)
+        {
+          layer[cell / 64] |= uint64_t(1) << (cell % 64);
+        }
+      }
+    }
+  });
 }
 
 //------------------------------------------------------------------------------

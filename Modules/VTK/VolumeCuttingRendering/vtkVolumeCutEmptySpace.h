@@ -11,6 +11,12 @@
  * composite mode), and a bound on the CT's trilinear gradient (per voxel)
  * that the border locator uses to decide whether a border could hide between
  * two samples. Rays step over empty blocks in one jump.
+ *
+ * In iso-surface mode, also per cell (between eight voxels): whether a
+ * visible object can be there at all, from the cell's largest CT value and
+ * the segments its corners carry. Beside bone most samples fall in cells
+ * where none can be (soft tissue under the iso-value): a ray walks through
+ * such cells to the next one that may hold a surface, without sampling.
  */
 #ifndef vtkVolumeCutEmptySpace_h
 #define vtkVolumeCutEmptySpace_h
@@ -67,6 +73,49 @@ public:
     return exit;
   }
 
+  /**
+   * Ray parameter where the ray (direction d in voxels, from p at t) enters
+   * the first cell that may hold a visible object, or tEnd; t itself when
+   * p's cell may. Cells are the anatomy's (unit cells between voxels).
+   */
+  double ExitEmptyCells(const double p[3], const double d[3], double t, double tEnd) const
+  {
+    if (this->CellBits.empty())
+    {
+      return t;
+    }
+    int cell[3];
+    int stepSign[3];
+    double next[3];
+    double delta[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      cell[axis] = std::min(std::max(static_cast<int>(std::floor(p[axis])), 0), this->CellDimensions[axis] - 1);
+      stepSign[axis] = d[axis] > 0.0 ? 1 : -1;
+      if (std::abs(d[axis]) < 1e-12)
+      {
+        next[axis] = delta[axis] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      const double wall = d[axis] > 0.0 ? cell[axis] + 1.0 : double(cell[axis]);
+      next[axis] = t + (wall - p[axis]) / d[axis];
+      delta[axis] = 1.0 / std::abs(d[axis]);
+    }
+    double entry = t;
+    while (!this->CellMayHoldObject(cell))
+    {
+      const int axis = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+      entry = next[axis];
+      cell[axis] += stepSign[axis];
+      if (!(entry < tEnd) || cell[axis] < 0 || cell[axis] >= this->CellDimensions[axis])
+      {
+        return tEnd;
+      }
+      next[axis] += delta[axis];
+    }
+    return entry;
+  }
+
   const int* GetDimensions() const { return this->Dimensions; }
   const uint8_t* GetOccupied() const { return this->Occupied.data(); }
   const float* GetGradientBounds() const { return this->GradientBound.data(); }
@@ -85,6 +134,19 @@ private:
   /// Chessboard distance in blocks to the nearest occupied block (0 for an
   /// occupied one, at most 255).
   void ComputeReach();
+  void BuildCells(const vtkVolumeCutRayScene& scene, int maximumThreads);
+
+  bool CellMayHoldObject(const int cell[3]) const
+  {
+    const size_t bit = static_cast<size_t>(cell[0] + this->CellDimensions[0] * cell[1]);
+    return (this->CellBits[static_cast<size_t>(cell[2]) * this->WordsPerCellLayer + bit / 64] >> (bit % 64)) & 1u;
+  }
+
+  // Cells: one bit each, every layer of cells starting a new word so that
+  // threads building different layers never share one.
+  int CellDimensions[3] = { 0, 0, 0 };
+  size_t WordsPerCellLayer = 0;
+  std::vector<uint64_t> CellBits;
 
   int Dimensions[3] = { 0, 0, 0 };
   std::vector<uint8_t> Occupied;

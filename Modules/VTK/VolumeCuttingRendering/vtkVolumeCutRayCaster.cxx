@@ -242,6 +242,26 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
       }
       continue;
     }
+    if (a.Object == 0)
+    {
+      // Through cells where nothing visible can be, to the last sample
+      // before the next cell that may hold a surface: the samples stay where
+      // a march without the jump puts them, so that the same grazing rays
+      // catch a surface's rim as on the GPU.
+      const double entry = emptySpace.ExitEmptyCells(a.Index, d, a.T, tEnd);
+      const double landing = a.T + std::floor((std::min(entry, tEnd) - a.T) / step) * step;
+      if (landing > a.T + step)
+      {
+        a = vtkVolumeCutSample::At(o, d, landing);
+        classifier.EvaluateObject(a);
+        insideVisible = classifier.Visible(a);
+        if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
+        {
+          return;
+        }
+        continue;
+      }
+    }
     vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
     classifier.EvaluateObject(b);
     if (pieces.Interval(ray, a, b, insideVisible, result))
