@@ -262,6 +262,29 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
         continue;
       }
     }
+    else if (!insideVisible && a.CutsKnown)
+    {
+      // Deep in a cavity: the cut fields are distances (1 mm per mm), so
+      // nothing is visible within the removed depth of this sample; the
+      // ray crosses it on its sample grid without classifying.
+      double removedDepth = 0.0;
+      for (size_t n = 0; n < scene.CutFields.size(); ++n)
+      {
+        removedDepth = std::max(removedDepth, -a.Distance[n]);
+      }
+      const double landing = a.T + std::floor(std::min(removedDepth, tEnd - a.T) / step) * step;
+      if (landing > a.T + step)
+      {
+        a = vtkVolumeCutSample::At(o, d, landing);
+        classifier.EvaluateObject(a);
+        insideVisible = classifier.Visible(a);
+        if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
+        {
+          return;
+        }
+        continue;
+      }
+    }
     vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
     classifier.EvaluateObject(b);
     if (pieces.Interval(ray, a, b, insideVisible, result))
