@@ -7,7 +7,7 @@
  *
  * Between two samples whose classes differ, each volume's border is located
  * on its own: bisection on the object class (vtkVolumeCutSampleClassifier)
- * (16 halvings) and on each cut field's distance (Illinois regula falsi, at
+ * (12 halvings) and on each cut field's distance (Illinois regula falsi, at
  * most 22 steps, to 2e-7 of the interval); the
  * volume's box and the clip planes analytically, as the ray's entry and
  * exit. Where a border could hide between two samples that agree (a grazing
@@ -54,9 +54,9 @@ struct vtkVolumeCutRay
 class vtkVolumeCutBorderLocator
 {
 public:
-  /// Halvings of a sample interval (0.5 voxel) for an object's border: 8e-6
-  /// voxel, finer than the GPU's single-precision ray parameter resolves.
-  static constexpr int ObjectBisections = 16;
+  /// Halvings of a sample interval (0.5 voxel) for an object's border:
+  /// 1.2e-4 voxel, a thousandth of a pixel where a voxel covers ten.
+  static constexpr int ObjectBisections = 12;
   /// At most this many steps for a cut field's border; the field is a
   /// distance, so its zero is found by regula falsi in a few.
   static constexpr int CutBisections = 22;
