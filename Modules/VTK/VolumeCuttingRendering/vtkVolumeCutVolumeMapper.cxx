@@ -29,6 +29,7 @@
 #include <vtkTimerLog.h>
 #include <vtkVolume.h>
 #include <vtkVolumeProperty.h>
+#include <vtkWeakPointer.h>
 #include <vtk_glad.h>
 
 #include <algorithm>
@@ -82,7 +83,8 @@ struct vtkVolumeCutVolumeMapper::Internals
   bool ReportedNoInput = false;
   // While the GPU program builds in parallel: a timer of the window's
   // interactor asks for frames until it is ready.
-  vtkRenderWindowInteractor* Interactor = nullptr;
+  // Weak: an interactor that goes first takes its observer with it.
+  vtkWeakPointer<vtkRenderWindowInteractor> Interactor;
   int ProgramTimer = 0;
   vtkNew<vtkCallbackCommand> ProgramTimerCallback;
   unsigned long ProgramTimerObserver = 0;
@@ -101,19 +103,23 @@ struct vtkVolumeCutVolumeMapper::Internals
 
   void AskForFrame(vtkRenderWindowInteractor* interactor)
   {
-    if (!interactor || this->ProgramTimer)
+    if (!interactor)
     {
       return;
     }
     if (interactor != this->Interactor)
     {
+      // Another interactor (or the last one gone): its timer is no longer ours.
       this->StopAsking();
       this->ProgramTimerCallback->SetClientData(this);
       this->ProgramTimerCallback->SetCallback(&Internals::OnProgramTimer);
       this->ProgramTimerObserver = interactor->AddObserver(vtkCommand::TimerEvent, this->ProgramTimerCallback);
       this->Interactor = interactor;
     }
-    this->ProgramTimer = interactor->CreateOneShotTimer(100);
+    if (!this->ProgramTimer)
+    {
+      this->ProgramTimer = interactor->CreateOneShotTimer(100);
+    }
   }
 
   void StopAsking()
