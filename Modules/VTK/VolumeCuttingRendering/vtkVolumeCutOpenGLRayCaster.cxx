@@ -3,6 +3,7 @@
 #include "vtkVolumeCutOpenGLRayCaster.h"
 
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutProgramBuilder.h"
 #include "vtkVolumeCutRayCaster.h"
 #include "vtkVolumeCutShaderComposer.h"
 
@@ -15,13 +16,16 @@
 #include <vtkOpenGLRenderWindow.h>
 #include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
+#include <vtkOpenGLVertexArrayObject.h>
 #include <vtkShaderProgram.h>
 #include <vtkSmartPointer.h>
 #include <vtkTextureObject.h>
+#include <vtkTimerLog.h>
 #include <vtk_glad.h>
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <vector>
@@ -69,8 +73,16 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
   vtkMTimeType SceneVersion = 0;
-  int ShaderCuts = -1;
-  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  // The program for the features of the last Render, and the quad it draws.
+  vtkVolumeCutProgramBuilder Builder;
+  std::string BuiltFeatures;
+  bool BuildChecked = false;
+  bool FirstDrawTimed = false;
+  vtkSmartPointer<vtkOpenGLVertexArrayObject> QuadVAO;
+  vtkShaderProgram* QuadProgram = nullptr;
+  // Set when a build exceeded the time limit: the GPU path stays off.
+  std::string TimedOutMessage;
+  std::string ReportedCacheWarning;
 
   void Release(vtkWindow* window)
   {
@@ -92,17 +104,29 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       }
       cut = CutTextures();
     }
-    if (this->Quad)
+    if (this->QuadVAO)
     {
-      this->Quad->ReleaseGraphicsResources(window);
-      this->Quad.reset();
+      this->QuadVAO->ReleaseGraphicsResources();
+      this->QuadVAO = nullptr;
     }
+    this->QuadProgram = nullptr;
+    // A build under way dies with its context; the next Render starts again.
+    this->Builder.Release(window);
+    this->BuiltFeatures.clear();
     this->AnatomyVersion = 0;
     this->LabelVersion = 0;
     this->SceneVersion = 0;
-    this->ShaderCuts = -1;
     this->Context = nullptr;
   }
+
+  static std::string Seconds(double value)
+  {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(value < 10.0 ? 2 : 1) << value << " s";
+    return text.str();
+  }
+
+  bool ReadyProgram(vtkVolumeCutOpenGLRayCaster* self, vtkOpenGLRenderWindow* window, const vtkVolumeCutShaderComposer::Features& features);
 
   static vtkSmartPointer<vtkTextureObject> Texture3D(
     vtkOpenGLRenderWindow* window, int x, int y, int z, int components, const float* data)
@@ -225,6 +249,114 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
 };
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutOpenGLRayCaster::Internals::ReadyProgram(
+  vtkVolumeCutOpenGLRayCaster* self, vtkOpenGLRenderWindow* window, const vtkVolumeCutShaderComposer::Features& features)
+{
+  auto seconds = &Internals::Seconds;
+  if (!this->TimedOutMessage.empty())
+  {
+    self->ProgramStatus = ProgramTimedOut;
+    self->LastErrorMessage = this->TimedOutMessage;
+    return false;
+  }
+  const std::string key = vtkVolumeCutShaderComposer::Describe(features) + '\n' + features.ExtraDeclarations;
+  if (key != this->BuiltFeatures || this->Builder.GetStatus() == vtkVolumeCutProgramBuilder::Empty)
+  {
+    // Other features: another program (a failed one is not tried again
+    // until the features change, so a rejecting driver costs one build).
+    const std::string fragment = vtkVolumeCutShaderComposer::FragmentShader(features);
+    self->ProgramSourceLength = static_cast<vtkIdType>(fragment.size());
+    self->ProgramFeatures = vtkVolumeCutShaderComposer::Describe(features);
+    this->BuiltFeatures = key;
+    this->BuildChecked = false;
+    this->FirstDrawTimed = false;
+    this->QuadProgram = nullptr;
+    std::string directory;
+    if (self->ProgramCache)
+    {
+      directory = self->ProgramCacheDirectory.empty() ? DefaultProgramCacheDirectory() : self->ProgramCacheDirectory;
+    }
+    this->Builder.Start(window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader(), fragment, directory);
+  }
+  const vtkVolumeCutProgramBuilder::Status status = this->Builder.Poll();
+  if (!this->FirstDrawTimed)
+  {
+    self->LastProgramBuildTime = this->Builder.GetBuildSeconds();
+  }
+  self->LastProgramLoadedFromCache = this->Builder.GetLoadedFromCache();
+  const std::string& cacheWarning = this->Builder.GetCacheWarning();
+  if (!cacheWarning.empty() && cacheWarning != this->ReportedCacheWarning)
+  {
+    // Once: the program is rebuilt from source and stored again.
+    vtkWarningWithObjectMacro(self, "Render: " << cacheWarning);
+    this->ReportedCacheWarning = cacheWarning;
+  }
+  const std::string limit = seconds(self->ProgramBuildTimeLimit);
+  switch (status)
+  {
+    case vtkVolumeCutProgramBuilder::Pending:
+      if (self->LastProgramBuildTime <= self->ProgramBuildTimeLimit)
+      {
+        self->ProgramStatus = ProgramPending;
+        self->LastErrorMessage = "the GPU program is being built (" + seconds(self->LastProgramBuildTime) + " so far, limit " + limit + ")";
+        return false;
+      }
+      this->TimedOutMessage = "the GPU program was not built after " + seconds(self->LastProgramBuildTime) + " on " +
+        self->DriverDescription + ", over ProgramBuildTimeLimit (" + limit + "); cuts are drawn on the CPU";
+      this->Builder.Release(window);
+      self->ProgramStatus = ProgramTimedOut;
+      self->LastErrorMessage = this->TimedOutMessage;
+      return false;
+    case vtkVolumeCutProgramBuilder::Failed:
+      self->ProgramStatus = ProgramFailed;
+      self->LastErrorMessage = "the OpenGL driver (" + self->DriverDescription + ") rejects the GPU program (" + self->ProgramFeatures +
+        "): " + this->Builder.GetError();
+      return false;
+    case vtkVolumeCutProgramBuilder::Ready:
+      break;
+    default:
+      self->ProgramStatus = ProgramNone;
+      self->LastErrorMessage = "no GPU program";
+      return false;
+  }
+  if (!this->BuildChecked)
+  {
+    this->BuildChecked = true;
+    if (self->LastProgramBuildTime > self->ProgramBuildTimeLimit)
+    {
+      // The build blocked the view for longer than allowed: the next one
+      // (other features, another start without the cache) would too.
+      this->TimedOutMessage = std::string(self->LastProgramLoadedFromCache ? "loading" : "building") + " the GPU program took " +
+        seconds(self->LastProgramBuildTime) + " on " + self->DriverDescription + ", over ProgramBuildTimeLimit (" + limit +
+        "); cuts are drawn on the CPU";
+      this->Builder.Release(window);
+      self->ProgramStatus = ProgramTimedOut;
+      self->LastErrorMessage = this->TimedOutMessage;
+      return false;
+    }
+  }
+  vtkShaderProgram* program = this->Builder.GetProgram();
+  window->GetShaderCache()->ReadyShaderProgram(program);
+  if (this->QuadProgram != program || !this->QuadVAO)
+  {
+    if (!this->QuadVAO)
+    {
+      this->QuadVAO = vtkSmartPointer<vtkOpenGLVertexArrayObject>::New();
+    }
+    this->QuadVAO->ReleaseGraphicsResources();
+    if (!vtkOpenGLRenderUtilities::PrepFullScreenVAO(window, this->QuadVAO, program))
+    {
+      self->ProgramStatus = ProgramFailed;
+      self->LastErrorMessage = "the full-screen quad cannot be set up for the GPU program";
+      return false;
+    }
+    this->QuadProgram = program;
+  }
+  self->ProgramStatus = ProgramReady;
+  return true;
+}
+
+//------------------------------------------------------------------------------
 vtkVolumeCutOpenGLRayCaster::vtkVolumeCutOpenGLRayCaster()
   : Impl(new Internals)
 {
@@ -305,6 +437,16 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     impl.Release(impl.Context);
   }
   impl.Context = window;
+  this->DriverDescription = vtkVolumeCutProgramBuilder::DriverDescription();
+  this->ParallelCompile = vtkVolumeCutProgramBuilder::HasParallelCompile();
+  this->NumberOfProgramBinaryFormats = vtkVolumeCutProgramBuilder::NumberOfBinaryFormats();
+  if (!impl.TimedOutMessage.empty())
+  {
+    // Nothing to upload for a path that stays off.
+    this->ProgramStatus = ProgramTimedOut;
+    this->LastErrorMessage = impl.TimedOutMessage;
+    return false;
+  }
 
   GLint maximum3D = 0;
   glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &maximum3D);
@@ -424,26 +566,20 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     return false;
   }
 
-  if (impl.ShaderCuts != cuts || !impl.Quad)
+  vtkVolumeCutShaderComposer::Features features;
+  features.CutFields = cuts;
+  features.LabelMap = view.Labels != nullptr;
+  features.Fractions = static_cast<int>(view.Fractions.size());
+  features.Composite = scene->GetBlendMode() == vtkVolumeCutRayCaster::CompositeBlend;
+  features.ThinBone = scene->GetThinBoneShading();
+  features.AmbientOcclusion = scene->GetAmbientOcclusion() && !features.Composite;
+  features.ClipPlanes = std::min(static_cast<int>(view.Planes.size()), 6);
+  features.ExtraDeclarations = this->ExtraFragmentDeclarations;
+  if (!impl.ReadyProgram(this, window, features))
   {
-    if (impl.Quad)
-    {
-      impl.Quad->ReleaseGraphicsResources(window);
-    }
-    vtkVolumeCutShaderComposer::Features features;
-    features.CutFields = cuts;
-    const std::string fragment = vtkVolumeCutShaderComposer::FragmentShader(features);
-    impl.Quad.reset(new vtkOpenGLQuadHelper(
-      window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), fragment.c_str(), ""));
-    impl.ShaderCuts = cuts;
-  }
-  if (!impl.Quad->Program || !impl.Quad->Program->GetCompiled())
-  {
-    this->LastErrorMessage = "the ray-casting shader does not compile on this OpenGL context";
     return false;
   }
-  window->GetShaderCache()->ReadyShaderProgram(impl.Quad->Program);
-  vtkShaderProgram* program = impl.Quad->Program;
+  vtkShaderProgram* program = impl.QuadProgram;
 
   vtkVolumeCutRayCaster* s = scene;
   float matrix[16];
@@ -506,6 +642,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniformi("ambientOcclusion", s->GetAmbientOcclusion() && s->GetBlendMode() == vtkVolumeCutRayCaster::IsoSurfaceBlend ? 1 : 0);
   program->SetUniformf("ambientOcclusionRadius", static_cast<float>(s->GetAmbientOcclusionRadius()));
   program->SetUniformi("refinements", view.MaximumRefinements);
+  program->SetUniformi("bisectionSteps", 22);
+  program->SetUniformi("occlusionDirections", 7);
   const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
   float planes[6][4] = {};
   for (int p = 0; p < planeCount; ++p)
@@ -554,7 +692,22 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     program->SetUniformf(("cutStep" + index).c_str(), static_cast<float>(0.25 * std::min({ spacing[0], spacing[1], spacing[2] })));
   }
 
-  DrawSurfaceQuad(window, impl.Quad.get());
+  const double drawStart = vtkTimerLog::GetUniversalTime();
+  DrawSurfaceQuad(window, impl.QuadVAO.GetPointer());
+  if (!impl.FirstDrawTimed)
+  {
+    // Drivers may compile the machine code at the first draw (llvmpipe
+    // does, for seconds): the build ends when the first image is done.
+    glFinish();
+    impl.FirstDrawTimed = true;
+    this->LastProgramBuildTime += vtkTimerLog::GetUniversalTime() - drawStart;
+    if (this->LastProgramBuildTime > this->ProgramBuildTimeLimit)
+    {
+      impl.TimedOutMessage = "building the GPU program and its first image took " + impl.Seconds(this->LastProgramBuildTime) + " on " +
+        this->DriverDescription + ", over ProgramBuildTimeLimit (" + impl.Seconds(this->ProgramBuildTimeLimit) +
+        "); cuts are drawn on the CPU from the next frame";
+    }
+  }
   for (vtkTextureObject* texture : active)
   {
     texture->Deactivate();
@@ -563,7 +716,10 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLQuadHelper* quad)
+namespace
+{
+template <typename Draw>
+void WithSurfaceState(vtkOpenGLRenderWindow* window, Draw draw)
 {
   vtkOpenGLState* state = window->GetState();
   vtkOpenGLState::ScopedglDepthMask depthMask(state);
@@ -578,7 +734,43 @@ void vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(vtkOpenGLRenderWindow* window,
   state->vtkglEnable(GL_DEPTH_TEST);
   state->vtkglDepthFunc(GL_ALWAYS);
   state->vtkglDepthMask(GL_TRUE);
-  quad->Render();
+  draw();
+}
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLQuadHelper* quad)
+{
+  WithSurfaceState(window, [quad]() { quad->Render(); });
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLVertexArrayObject* quad)
+{
+  WithSurfaceState(window, [quad]() {
+    quad->Bind();
+    vtkOpenGLRenderUtilities::DrawFullScreenQuad();
+    quad->Release();
+  });
+}
+
+//------------------------------------------------------------------------------
+std::string vtkVolumeCutOpenGLRayCaster::DefaultProgramCacheDirectory()
+{
+  return vtkVolumeCutProgramBuilder::DefaultCacheDirectory();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutOpenGLRayCaster::SetProgramBuildTimeLimit(double seconds)
+{
+  // Set again, the limit lets the GPU path try once more.
+  this->Impl->TimedOutMessage.clear();
+  if (this->ProgramStatus == ProgramTimedOut)
+  {
+    this->ProgramStatus = ProgramNone;
+  }
+  this->ProgramBuildTimeLimit = std::max(0.0, seconds);
+  this->Modified();
 }
 
 //------------------------------------------------------------------------------
@@ -589,4 +781,14 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
      << ")\n";
   os << indent << "TextureMemorySize: " << this->GetTextureMemorySize() << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
+  os << indent << "ProgramStatus: " << this->ProgramStatus << " (" << this->ProgramFeatures << ", " << this->ProgramSourceLength
+     << " characters)\n";
+  os << indent << "ProgramBuildTimeLimit: " << this->ProgramBuildTimeLimit << "\n";
+  os << indent << "ProgramCacheDirectory: " << this->ProgramCacheDirectory << "\n";
+  os << indent << "ProgramCache: " << this->ProgramCache << "\n";
+  os << indent << "ExtraFragmentDeclarations: " << this->ExtraFragmentDeclarations << "\n";
+  os << indent << "LastProgramBuildTime: " << this->LastProgramBuildTime << (this->LastProgramLoadedFromCache ? " (cached)" : "")
+     << "\n";
+  os << indent << "Driver: " << this->DriverDescription << " (parallel compile " << this->ParallelCompile << ", "
+     << this->NumberOfProgramBinaryFormats << " binary formats)\n";
 }

@@ -17,6 +17,15 @@
  * the 3D texture limit, too many cut fields, texture allocation failed); the
  * caller then uses the CPU reference.
  *
+ * The program is built for the features in use (vtkVolumeCutShaderComposer)
+ * without blocking the view where the driver compiles in parallel
+ * (GL_KHR_parallel_shader_compile): while GetProgramStatus() is
+ * ProgramPending, Render() returns false and the caller draws the CPU image.
+ * A build (or a wait for one) longer than ProgramBuildTimeLimit gives
+ * ProgramTimedOut, and the GPU path stays off until the limit is set again.
+ * Programs are kept on disk as driver binaries (ProgramCacheDirectory) so a
+ * second start needs no compilation.
+ *
  * @sa vtkVolumeCutVolumeMapper vtkVolumeCutRayCaster
  */
 
@@ -31,6 +40,7 @@
 
 class vtkMatrix4x4;
 class vtkOpenGLQuadHelper;
+class vtkOpenGLVertexArrayObject;
 class vtkOpenGLRenderWindow;
 class vtkVolumeCutRayCaster;
 class vtkWindow;
@@ -57,6 +67,83 @@ public:
   /// Why the last Render returned false (empty after a success).
   const char* GetLastErrorMessage() const { return this->LastErrorMessage.c_str(); }
 
+  enum ProgramStatuses
+  {
+    ProgramNone = 0,     ///< no program asked for yet
+    ProgramPending = 1,  ///< the driver is compiling it (parallel compile)
+    ProgramReady = 2,    ///< built: Render draws
+    ProgramFailed = 3,   ///< the driver rejected it (GetLastErrorMessage says why)
+    ProgramTimedOut = 4  ///< its build exceeded ProgramBuildTimeLimit
+  };
+
+  /// The state of the program for the last Render's features.
+  vtkGetMacro(ProgramStatus, int);
+
+  ///@{
+  /**
+   * Set/get the longest a program build may take, in seconds, before the GPU
+   * path gives way to the CPU (ProgramTimedOut): a build that blocks longer,
+   * or a parallel build not finished by then. Setting it again (any value)
+   * lets the GPU path try once more. Default is 10.
+   */
+  void SetProgramBuildTimeLimit(double seconds);
+  vtkGetMacro(ProgramBuildTimeLimit, double);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the folder of cached program binaries. Empty (the default) means
+   * DefaultProgramCacheDirectory(); the cache is used where the driver offers
+   * a binary format (GL_NUM_PROGRAM_BINARY_FORMATS > 0) and ProgramCache is on.
+   */
+  vtkSetStdStringFromCharMacro(ProgramCacheDirectory);
+  vtkGetCharFromStdStringMacro(ProgramCacheDirectory);
+  ///@}
+
+  ///@{
+  /** Set/get whether program binaries are cached on disk. Default is true. */
+  vtkSetMacro(ProgramCache, bool);
+  vtkGetMacro(ProgramCache, bool);
+  vtkBooleanMacro(ProgramCache, bool);
+  ///@}
+
+  /// $XDG_CACHE_HOME (or ~/.cache, %LOCALAPPDATA%) /VolumeCutting/programs.
+  static std::string DefaultProgramCacheDirectory();
+
+  ///@{
+  /**
+   * Set/get GLSL added to the fragment shader before main() (empty by
+   * default): helper functions for instrumenting the program. A change
+   * builds a new program; code the driver rejects gives ProgramFailed (the
+   * tests use this to make a driver reject the program).
+   */
+  vtkSetStdStringFromCharMacro(ExtraFragmentDeclarations);
+  vtkGetCharFromStdStringMacro(ExtraFragmentDeclarations);
+  ///@}
+
+  /**
+   * Seconds the last program build took: compile and link (or loading the
+   * cached binary) and its first image, as drivers may compile the machine
+   * code at the first draw; the time so far while pending.
+   */
+  vtkGetMacro(LastProgramBuildTime, double);
+
+  /// Whether the last program came from the on-disk cache.
+  vtkGetMacro(LastProgramLoadedFromCache, bool);
+
+  /// Characters of the last program's fragment shader (its size for the features in use).
+  vtkGetMacro(ProgramSourceLength, vtkIdType);
+
+  /// The features the last program was built for ("cuts=1 labels iso ...").
+  const char* GetProgramFeatures() const { return this->ProgramFeatures.c_str(); }
+
+  /// The OpenGL driver of the last Render: GL_RENDERER, GL_VERSION and GL_VENDOR.
+  const char* GetDriverDescription() const { return this->DriverDescription.c_str(); }
+
+  /// Whether the last Render's context compiles in parallel; its number of program binary formats.
+  vtkGetMacro(ParallelCompile, bool);
+  vtkGetMacro(NumberOfProgramBinaryFormats, int);
+
   /// Bricks of cut fields uploaded by the last Render, and in total.
   vtkGetMacro(NumberOfBricksUploaded, vtkIdType);
   vtkGetMacro(TotalNumberOfBricksUploaded, vtkIdType);
@@ -72,12 +159,25 @@ public:
    * restored after). Both paths draw their images this way.
    */
   static void DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLQuadHelper* quad);
+  static void DrawSurfaceQuad(vtkOpenGLRenderWindow* window, vtkOpenGLVertexArrayObject* quad);
 
 protected:
   vtkVolumeCutOpenGLRayCaster();
   ~vtkVolumeCutOpenGLRayCaster() override;
 
   std::string LastErrorMessage;
+  int ProgramStatus = ProgramNone;
+  double ProgramBuildTimeLimit = 10.0;
+  std::string ProgramCacheDirectory;
+  bool ProgramCache = true;
+  std::string ExtraFragmentDeclarations;
+  double LastProgramBuildTime = 0.0;
+  bool LastProgramLoadedFromCache = false;
+  vtkIdType ProgramSourceLength = 0;
+  std::string ProgramFeatures;
+  std::string DriverDescription;
+  bool ParallelCompile = false;
+  int NumberOfProgramBinaryFormats = 0;
   vtkIdType NumberOfBricksUploaded = 0;
   vtkIdType TotalNumberOfBricksUploaded = 0;
 

@@ -17,6 +17,7 @@
 #include <vtkShaderProgram.h>
 
 #include <algorithm>
+#include <utility>
 
 //------------------------------------------------------------------------------
 std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
@@ -30,11 +31,40 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::EmptySpace::Dec", vtkVolumeCutEmptySpaceFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::BorderLocation::Dec", vtkVolumeCutBorderLocationFS);
-  vtkShaderProgram::Substitute(source, "//VolumeCut::AmbientOcclusion::Dec", vtkVolumeCutAmbientOcclusionFS);
-  vtkShaderProgram::Substitute(source, "//VolumeCut::ThinBone::Dec", vtkVolumeCutThinBoneFS);
+  // A stage not in use is a stub of the same signature: its uniforms and
+  // loops never reach the compiler.
+  vtkShaderProgram::Substitute(source, "//VolumeCut::AmbientOcclusion::Dec",
+    features.AmbientOcclusion ? vtkVolumeCutAmbientOcclusionFS
+                              : "const int ambientOcclusion = 0;\nfloat occlusion(vec3 index, vec3 normal) { return 0.0; }\n");
+  vtkShaderProgram::Substitute(source, "//VolumeCut::ThinBone::Dec",
+    features.ThinBone ? vtkVolumeCutThinBoneFS
+                      : "const int thinBone = 0;\n"
+                        "void applyThinBone(int object, vec3 index, vec3 normal, inout vec3 rgb, inout float alpha) {}\n");
   vtkShaderProgram::Substitute(source, "//VolumeCut::Shading::Dec", vtkVolumeCutShadingFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::PieceClassification::Dec", vtkVolumeCutPieceClassificationFS);
-  vtkShaderProgram::Substitute(source, "//VolumeCut::Composite::Dec", vtkVolumeCutCompositeFS);
+  vtkShaderProgram::Substitute(source, "//VolumeCut::Composite::Dec",
+    (features.Composite ? std::string(vtkVolumeCutCompositeFS)
+                        : std::string("bool compositeStep(inout Sample a, inout Sample b, inout int lastCutBorder) { return true; }\n")) +
+      features.ExtraDeclarations);
+
+  // The scene's switches become constants: the compiler drops the branches
+  // of features not in use.
+  const int fractions = std::min(std::max(features.Fractions, 0), 4);
+  const int planes = std::min(std::max(features.ClipPlanes, 0), 6);
+  const std::pair<const char*, int> constants[] = {
+    { "hasLabels", features.LabelMap || fractions > 0 ? 1 : 0 },
+    { "hasLabelMap", features.LabelMap ? 1 : 0 },
+    { "fractionCount", fractions },
+    { "blendMode", features.Composite ? 1 : 0 },
+    { "thinBone", features.ThinBone ? 1 : 0 },
+    { "ambientOcclusion", features.AmbientOcclusion ? 1 : 0 },
+    { "planeCount", planes },
+  };
+  for (const auto& constant : constants)
+  {
+    const std::string name = constant.first;
+    vtkShaderProgram::Substitute(source, "uniform int " + name + ";", "const int " + name + " = " + std::to_string(constant.second) + ";");
+  }
 
   // One copy of the cut-field code per field, and the dispatch by index.
   std::string declarations;
@@ -56,4 +86,17 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutField::Calls", calls);
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutField::Init", init);
   return source;
+}
+
+//------------------------------------------------------------------------------
+std::string vtkVolumeCutShaderComposer::Describe(const Features& features)
+{
+  std::string text = "cuts=" + std::to_string(features.CutFields);
+  text += features.LabelMap ? " labels" : "";
+  text += features.Fractions > 0 ? " fractions=" + std::to_string(features.Fractions) : "";
+  text += features.Composite ? " composite" : " iso";
+  text += features.ThinBone ? " thin-bone" : "";
+  text += features.AmbientOcclusion ? " occlusion" : "";
+  text += features.ClipPlanes > 0 ? " planes=" + std::to_string(features.ClipPlanes) : "";
+  return text;
 }

@@ -11,6 +11,15 @@
  * sampling, each replaced by that stage's snippet, glsl/vtkVolumeCut<Stage>FS.glsl
  * (compiled into the library with vtk_encode_string), and the cut-field
  * snippet is written once per field.
+ *
+ * A program is specialized to the features in use: the scene's switches
+ * (label map, fractional labelmaps, blend mode, thin bone, ambient
+ * occlusion, clip planes) become constants the compiler folds, and the
+ * snippets of stages not in use (composite, thin bone, ambient occlusion)
+ * are left out, so that a driver compiles only what it will run. Loops over
+ * sample evaluations take their bounds from uniforms: drivers unroll loops
+ * with constant bounds, and unrolled bisections of unrolled classifications
+ * took minutes to compile (issue 12).
  */
 #ifndef vtkVolumeCutShaderComposer_h
 #define vtkVolumeCutShaderComposer_h
@@ -25,7 +34,24 @@ public:
   {
     /// Cut fields sampled (each gets its own textures and code).
     int CutFields = 0;
+    /// A label map is sampled.
+    bool LabelMap = false;
+    /// Segments given as fractional labelmaps (0 to 4).
+    int Fractions = 0;
+    /// Composite blend (the transfer functions) instead of iso-surfaces.
+    bool Composite = false;
+    /// Thin-bone shading.
+    bool ThinBone = false;
+    /// Ambient occlusion.
+    bool AmbientOcclusion = false;
+    /// Clip planes (0 to 6).
+    int ClipPlanes = 0;
+    /// GLSL added before main() (empty unless the caster was given some).
+    std::string ExtraDeclarations;
   };
+
+  /// A short description of the features ("cuts=2 labels fractions=1 iso ...").
+  static std::string Describe(const Features& features);
 
   /// The complete fragment shader for these features.
   static std::string FragmentShader(const Features& features);

@@ -20,7 +20,9 @@
 #include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
 #include <vtkPiecewiseFunction.h>
+#include <vtkCallbackCommand.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkShaderProgram.h>
 #include <vtkSmartPointer.h>
@@ -127,7 +129,62 @@ struct vtkVolumeCutVolumeMapper::Internals
     this->TimedWindow = nullptr;
   }
   int ReportedPath = 0;
+  std::string ReportedReason;
   bool ReportedNoInput = false;
+  // While the GPU program builds in parallel: a timer of the window's
+  // interactor asks for frames until it is ready.
+  // Weak: an interactor that goes first takes its observer with it.
+  vtkWeakPointer<vtkRenderWindowInteractor> Interactor;
+  int ProgramTimer = 0;
+  vtkNew<vtkCallbackCommand> ProgramTimerCallback;
+  unsigned long ProgramTimerObserver = 0;
+
+  static void OnProgramTimer(vtkObject* caller, unsigned long, void* clientData, void* callData)
+  {
+    auto* self = static_cast<Internals*>(clientData);
+    auto* interactor = vtkRenderWindowInteractor::SafeDownCast(caller);
+    if (!interactor || !callData || *static_cast<int*>(callData) != self->ProgramTimer)
+    {
+      return;
+    }
+    self->ProgramTimer = 0;
+    interactor->Render();
+  }
+
+  void AskForFrame(vtkRenderWindowInteractor* interactor)
+  {
+    if (!interactor)
+    {
+      return;
+    }
+    if (interactor != this->Interactor)
+    {
+      // Another interactor (or the last one gone): its timer is no longer ours.
+      this->StopAsking();
+      this->ProgramTimerCallback->SetClientData(this);
+      this->ProgramTimerCallback->SetCallback(&Internals::OnProgramTimer);
+      this->ProgramTimerObserver = interactor->AddObserver(vtkCommand::TimerEvent, this->ProgramTimerCallback);
+      this->Interactor = interactor;
+    }
+    if (!this->ProgramTimer)
+    {
+      this->ProgramTimer = interactor->CreateOneShotTimer(100);
+    }
+  }
+
+  void StopAsking()
+  {
+    if (this->Interactor)
+    {
+      if (this->ProgramTimer)
+      {
+        this->Interactor->DestroyTimer(this->ProgramTimer);
+      }
+      this->Interactor->RemoveObserver(this->ProgramTimerObserver);
+    }
+    this->Interactor = nullptr;
+    this->ProgramTimer = 0;
+  }
   vtkOpenGLRenderWindow* Context = nullptr;
   vtkSmartPointer<vtkTextureObject> Color;
   vtkSmartPointer<vtkTextureObject> Depth;
@@ -162,6 +219,7 @@ vtkVolumeCutVolumeMapper::vtkVolumeCutVolumeMapper()
 vtkVolumeCutVolumeMapper::~vtkVolumeCutVolumeMapper()
 {
   this->Impl->StopTimingFrames();
+  this->Impl->StopAsking();
   if (this->Impl->Context)
   {
     this->Impl->Release(this->Impl->Context);
@@ -205,6 +263,38 @@ const char* vtkVolumeCutVolumeMapper::GetLastRenderPathAsString() const
 const char* vtkVolumeCutVolumeMapper::GetGPUFallbackReason() const
 {
   return this->Impl->FallbackReason.c_str();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutVolumeMapper::SetProgramBuildTimeLimit(double seconds)
+{
+  this->Impl->OpenGLRayCaster->SetProgramBuildTimeLimit(seconds);
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutVolumeMapper::GetProgramBuildTimeLimit()
+{
+  return this->Impl->OpenGLRayCaster->GetProgramBuildTimeLimit();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutVolumeMapper::SetProgramCacheDirectory(const char* directory)
+{
+  this->Impl->OpenGLRayCaster->SetProgramCacheDirectory(directory);
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+const char* vtkVolumeCutVolumeMapper::GetProgramCacheDirectory()
+{
+  return this->Impl->OpenGLRayCaster->GetProgramCacheDirectory();
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutVolumeMapper::GetLastProgramBuildTime()
+{
+  return this->Impl->OpenGLRayCaster->GetLastProgramBuildTime();
 }
 
 //------------------------------------------------------------------------------
@@ -313,19 +403,22 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   }
   else if (this->RequestedRenderPath != CPUPath)
   {
-    if (impl.OpenGLRayCaster->Render(window, caster, worldToNDC, x0, y0, width, height, opaqueDepth.data()))
+    vtkVolumeCutOpenGLRayCaster* gpu = impl.OpenGLRayCaster;
+    if (gpu->Render(window, caster, worldToNDC, x0, y0, width, height, opaqueDepth.data()))
     {
       path = GPUPath;
       impl.FallbackReason.clear();
     }
     else
     {
-      impl.FallbackReason = impl.OpenGLRayCaster->GetLastErrorMessage();
-      if (this->RequestedRenderPath == GPUPath)
-      {
-        vtkErrorMacro("Render: the GPU path was requested but cannot run: " << impl.FallbackReason);
-        return;
-      }
+      // Whatever stops the GPU (a program still building, rejected or too
+      // slow to build, a volume beyond the texture limit), the CPU draws:
+      // the view never freezes.
+      impl.FallbackReason = gpu->GetLastErrorMessage();
+    }
+    if (gpu->GetProgramStatus() == vtkVolumeCutOpenGLRayCaster::ProgramPending)
+    {
+      impl.AskForFrame(renderer->GetRenderWindow()->GetInteractor());
     }
   }
   int sampleDistance = 1;
@@ -337,14 +430,19 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
       return;
     }
   }
-  if (path != impl.ReportedPath)
+  const bool transient = path == CPUPath && impl.OpenGLRayCaster->GetProgramStatus() == vtkVolumeCutOpenGLRayCaster::ProgramPending &&
+    this->RequestedRenderPath != CPUPath;
+  if (!transient && (path != impl.ReportedPath || (path == CPUPath && impl.FallbackReason != impl.ReportedReason)))
   {
-    // Once per change, so that the log says which implementation draws.
-    if (path == CPUPath && this->RequestedRenderPath == AutomaticPath)
+    // Once per change, so that the log says which implementation draws and
+    // why (a program still building is no reason to warn).
+    if (path == CPUPath && this->RequestedRenderPath != CPUPath)
     {
-      vtkWarningMacro("Rendering cuts on the CPU: " << impl.FallbackReason);
+      vtkWarningMacro("Rendering cuts on the CPU" << (this->RequestedRenderPath == GPUPath ? " although the GPU path was requested" : "")
+                                                  << ": " << impl.FallbackReason);
     }
     impl.ReportedPath = path;
+    impl.ReportedReason = path == CPUPath ? impl.FallbackReason : std::string();
   }
   this->LastRenderPath = path;
   this->LastImageSampleDistance = sampleDistance;
@@ -508,6 +606,8 @@ void vtkVolumeCutVolumeMapper::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "RequestedRenderPath: " << this->RequestedRenderPath << "\n";
   os << indent << "LastRenderPath: " << this->GetLastRenderPathAsString() << "\n";
   os << indent << "GPUFallbackReason: " << this->Impl->FallbackReason << "\n";
+  os << indent << "OpenGLRayCaster:\n";
+  this->Impl->OpenGLRayCaster->PrintSelf(os, indent.GetNextIndent());
   os << indent << "LastFrameTime: " << this->LastFrameTime << "\n";
   os << indent << "InteractiveUpdateRate: " << this->InteractiveUpdateRate << "\n";
   os << indent << "MaximumImageSampleDistance: " << this->MaximumImageSampleDistance << "\n";

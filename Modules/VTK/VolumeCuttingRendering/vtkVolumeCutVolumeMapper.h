@@ -16,6 +16,17 @@
  * geometry already drawn. GetLastRenderPath() says which ran, and a change of
  * path is reported once in the log with the reason.
  *
+ * The GPU path never blocks the view for longer than ProgramBuildTimeLimit
+ * (issue 12): the program is built for the features in use; where the
+ * driver compiles in parallel, the CPU image is drawn until the program is
+ * ready (the interactor, if any, is asked for a frame every 100 ms until
+ * then); a build that takes longer than the limit, or a driver that rejects
+ * the program, a volume beyond the 3D texture limit or a lost context
+ * leaves the CPU path drawing, with the reason (driver, measured time) in
+ * GetGPUFallbackReason() and once in the log. Program binaries are cached on
+ * disk (ProgramCacheDirectory), so a second start builds nothing.
+ * A GPU path requested explicitly that cannot run draws the CPU image too.
+ *
  * The volume's matrix and the image's geometry place the CT in world
  * coordinates (in Slicer: IJK-to-RAS); cut fields are in world coordinates.
  * Blend modes: ISOSURFACE_BLEND (default, surfaces per segment) and
@@ -84,6 +95,30 @@ public:
 
   /// Why the GPU path was not used in the last frame (empty if it was).
   const char* GetGPUFallbackReason() const;
+
+  ///@{
+  /**
+   * Set/get the longest, in seconds, that building the GPU program may keep
+   * the GPU path from drawing; past it the CPU path draws for the rest of the
+   * session (setting the limit again lets the GPU try once more). Default is
+   * 10. Forwarded to vtkVolumeCutOpenGLRayCaster.
+   */
+  void SetProgramBuildTimeLimit(double seconds);
+  double GetProgramBuildTimeLimit();
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the folder of cached GPU program binaries; empty (the default)
+   * for $XDG_CACHE_HOME/VolumeCutting/programs (~/.cache/... without it).
+   * Forwarded to vtkVolumeCutOpenGLRayCaster.
+   */
+  void SetProgramCacheDirectory(const char* directory);
+  const char* GetProgramCacheDirectory();
+  ///@}
+
+  /// Seconds the last GPU program build took (compile and link, or loading it from the cache).
+  double GetLastProgramBuildTime();
 
   /// The scene besides the CT, and the CPU reference implementation.
   vtkVolumeCutRayCaster* GetRayCaster();

@@ -518,6 +518,12 @@ def softcut(repeats: int) -> list[dict]:
     return softcutbenchmarks.softcut_area(repeats)
 
 
+def gpuprogram(repeats: int) -> list[dict]:
+    from . import programbenchmarks
+
+    return programbenchmarks.gpuprogram(repeats)
+
+
 def webapp(repeats: int) -> list[dict]:
     from .webapp import benchmark
 
@@ -528,6 +534,7 @@ AREAS = {
     "foundation": foundation,
     "cutfield": cutfield,
     "mapper": mapper,
+    "gpuprogram": gpuprogram,
     "workflow": workflow,
     "haptics": haptics,
     "interactive": interactive,

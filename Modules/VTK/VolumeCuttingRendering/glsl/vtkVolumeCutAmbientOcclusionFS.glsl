@@ -7,6 +7,9 @@
 
 uniform int ambientOcclusion;
 uniform float ambientOcclusionRadius;
+// 7: the normal and six directions around it. A uniform so that the loop,
+// each pass a sample evaluation, stays a loop (see bisectionSteps).
+uniform int occlusionDirections;
 
 float occlusion(vec3 index, vec3 normal)
 {
@@ -17,7 +20,7 @@ float occlusion(vec3 index, vec3 normal)
   float cosine = cos(radians(55.0));
   float sine = sin(radians(55.0));
   int occupied = 0;
-  for (int direction = 0; direction < 7; ++direction)
+  for (int direction = 0; direction < occlusionDirections; ++direction)
   {
     float angle = 3.14159265358979 / 3.0 * float(direction);
     vec3 d = direction == 0 ? normal : cosine * normal + sine * (cos(angle) * tangent + sin(angle) * bitangent);

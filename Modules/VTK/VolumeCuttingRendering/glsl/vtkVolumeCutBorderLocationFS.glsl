@@ -8,6 +8,10 @@
 
 uniform int planeCount;
 uniform vec4 planes[6];
+// Halvings of a bisection (22: 2^-22 of a step). A uniform, not a constant:
+// a constant bound lets drivers unroll the loop, and with it every sample
+// evaluation inside, into minutes of compilation.
+uniform int bisectionSteps;
 
 // Entry and exit of the ray (tStart, tEnd: its near and far limits before):
 // the volume's box, the sample domain, then the clip planes; entryNormal
@@ -77,7 +81,7 @@ float bisectObject(Sample a, Sample b)
 {
   float lo = a.t;
   float hi = b.t;
-  for (int iteration = 0; iteration < 22; ++iteration)
+  for (int iteration = 0; iteration < bisectionSteps; ++iteration)
   {
     Sample mid = sampleAt(0.5 * (lo + hi));
     evaluateObject(mid);
@@ -98,7 +102,7 @@ float bisectCut(int n, Sample a, Sample b)
   float lo = a.t;
   float hi = b.t;
   bool loRemoved = a.distance[n] < 0.0;
-  for (int iteration = 0; iteration < 22; ++iteration)
+  for (int iteration = 0; iteration < bisectionSteps; ++iteration)
   {
     float t = 0.5 * (lo + hi);
     if ((cutDistance(n, worldPoint(rayOrigin + t * rayDirection)) < 0.0) == loRemoved)

@@ -421,11 +421,17 @@ def test_gpu_path_falls_back_to_the_cpu_with_a_reason():
     assert np.any(depth < 1.0)
     window.Render()
     assert sum("Rendering cuts on the CPU" in m for m in log.messages) == 1  # once, not every frame
-    # The GPU path asked for explicitly: a clear error, nothing drawn, no crash.
+    # The GPU path asked for explicitly: the CPU image all the same, with the reason.
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    window.Render()
+    cpu_image = read_window(window, width)
     mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
     window.Render()
-    assert mapper.GetLastRenderPath() == 0
-    assert "3D texture limit" in log.messages[-1]
+    assert mapper.GetLastRenderPath() == vc.vtkVolumeCutVolumeMapper.CPUPath
+    assert "exceeds this GPU's 3D texture limit" in mapper.GetGPUFallbackReason()
+    assert "GPU path was requested" in log.messages[-1] and "3D texture limit" in log.messages[-1]
+    for expected, drawn in zip(cpu_image, read_window(window, width)):
+        assert np.array_equal(expected, drawn)
     # Without input: nothing drawn, no crash (the renderer may not even call it).
     empty_mapper = vc.vtkVolumeCutVolumeMapper()
     empty_volume = vtk.vtkVolume()

@@ -1,0 +1,172 @@
+"""Benchmark area ``gpuprogram``: building the GPU program, first start against a cached start.
+
+A start is a new process (as a new start of the application), rendering the
+analytic cut cube of ``analyticscene.py`` on the GPU path; its build time is
+the mapper's ``GetLastProgramBuildTime()``: compile and link (or loading the
+cached binary) and the program's first image, as drivers may compile the
+machine code at the first draw (Mesa's llvmpipe does). Mesa keeps a shader
+cache of its own (``MESA_SHADER_CACHE_DIR``), so each configuration gets
+fresh folders for both caches, and the baseline (the first start with both
+empty) is measured in the same run.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from .benchmarks import machine_description, measurement
+
+WIDTH = 128
+
+# Feature sets whose program size and cold build time are reported.
+FEATURE_SETS = {
+    "iso, 1 cut": {},
+    "iso, 4 cuts": {"cuts": 4},
+    "iso, ambient occlusion": {"occlusion": True},
+    "iso, thin bone, 1 clip plane": {"thin_bone": True, "plane": True},
+    "composite, 1 cut": {"composite": True},
+}
+
+
+def one_start(cache_directory: str, use_cache: bool, features: dict) -> dict:
+    """In this process: render the cut cube once on the GPU path, return the program's figures."""
+    import time
+
+    import slicer_volumecutting as vc
+    import vtk
+
+    from . import analyticscene as A
+
+    scene = A.default_scene()
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(WIDTH, WIDTH)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    renderer.SetActiveCamera(A.make_camera(scene, 2.0, WIDTH, WIDTH))
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(scene.intensities())
+    caster = mapper.GetRayCaster()
+    caster.SetIsoValue(scene.iso_value())
+    for _ in range(features.get("cuts", 1)):
+        caster.AddCutField(scene.cut_field(1))
+    caster.SetAmbientOcclusion(features.get("occlusion", False))
+    caster.SetThinBoneShading(features.get("thin_bone", False))
+    if features.get("plane"):
+        planes = vtk.vtkPlaneCollection()
+        plane = vtk.vtkPlane()
+        plane.SetOrigin(*scene.center)
+        plane.SetNormal(0.0, 0.0, -1.0)
+        planes.AddItem(plane)
+        mapper.SetClippingPlanes(planes)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetUserMatrix(scene.ijk_to_ras())
+    if features.get("composite"):
+        color = vtk.vtkColorTransferFunction()
+        color.AddRGBPoint(0.0, 1.0, 1.0, 1.0)
+        color.AddRGBPoint(1000.0, 1.0, 0.9, 0.8)
+        opacity = vtk.vtkPiecewiseFunction()
+        opacity.AddPoint(400.0, 0.0)
+        opacity.AddPoint(1000.0, 0.5)
+        volume.GetProperty().SetColor(color)
+        volume.GetProperty().SetScalarOpacity(opacity)
+        mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
+    renderer.AddVolume(volume)
+    gpu = mapper.GetOpenGLRayCaster()
+    gpu.SetProgramCache(use_cache)
+    mapper.SetProgramCacheDirectory(cache_directory)
+    mapper.SetProgramBuildTimeLimit(600.0)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
+    start = time.perf_counter()
+    window.Render()
+    first_frame = time.perf_counter() - start
+    start = time.perf_counter()
+    window.Render()
+    second_frame = time.perf_counter() - start
+    return {
+        "path": mapper.GetLastRenderPathAsString(),
+        "reason": mapper.GetGPUFallbackReason(),
+        "build_s": mapper.GetLastProgramBuildTime(),
+        "loaded_from_cache": bool(gpu.GetLastProgramLoadedFromCache()),
+        "first_frame_s": first_frame,
+        "second_frame_s": second_frame,
+        "fragment_characters": gpu.GetProgramSourceLength(),
+        "features": gpu.GetProgramFeatures(),
+        "driver": gpu.GetDriverDescription(),
+        "parallel_compile": bool(gpu.GetParallelCompile()),
+        "binary_formats": gpu.GetNumberOfProgramBinaryFormats(),
+    }
+
+
+def _start(mesa_cache: Path, our_cache: Path, use_cache: bool, features: dict) -> dict:
+    """One start in a new process with these cache folders."""
+    code = (
+        "import json, sys; from VolumeCuttingLib import programbenchmarks as p; "
+        f"print('RESULT ' + json.dumps(p.one_start({str(our_cache)!r}, {use_cache!r}, {features!r})))"
+    )
+    environment = dict(os.environ, MESA_SHADER_CACHE_DIR=str(mesa_cache))
+    environment.pop("MESA_SHADER_CACHE_DISABLE", None)
+    environment["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[1]), environment.get("PYTHONPATH", "")])
+    result = subprocess.run([sys.executable, "-c", code], env=environment, capture_output=True, text=True, timeout=900)
+    lines = [line for line in result.stdout.splitlines() if line.startswith("RESULT ")]
+    if result.returncode != 0 or not lines:
+        raise RuntimeError(f"gpuprogram benchmark: a start failed ({result.returncode}): {result.stderr[-2000:]}")
+    figures = json.loads(lines[-1][len("RESULT "):])
+    if figures["path"] != "GPU":
+        raise RuntimeError(f"gpuprogram benchmark: the GPU path did not draw: {figures['reason']}")
+    return figures
+
+
+def gpuprogram(repeats: int) -> list[dict]:
+    runs = {"first": [], "cached": [], "mesa_only": [], "ours_only": []}
+    for _ in range(repeats):
+        with tempfile.TemporaryDirectory() as folder:
+            root = Path(folder)
+            mesa, ours, fresh_mesa = root / "mesa", root / "programs", root / "mesa-fresh"
+            runs["first"].append(_start(mesa, ours, True, {}))
+            runs["cached"].append(_start(mesa, ours, True, {}))
+            runs["mesa_only"].append(_start(mesa, ours, False, {}))
+            runs["ours_only"].append(_start(fresh_mesa, ours, True, {}))
+    features = {}
+    for name, feature_set in FEATURE_SETS.items():
+        with tempfile.TemporaryDirectory() as folder:
+            figures = _start(Path(folder) / "mesa", Path(folder) / "programs", True, feature_set)
+        features[name] = {key: figures[key] for key in ("features", "fragment_characters", "build_s", "second_frame_s")}
+    driver = runs["first"][0]["driver"]
+    machine = machine_description(driver.split(", OpenGL")[0])
+    machine["driver"] = driver
+
+    def median(kind, key="build_s"):
+        return statistics.median(run[key] for run in runs[kind])
+
+    first = median("first")
+    baseline = "first start on the same driver: both caches empty (our program cache and Mesa's shader cache in fresh folders), same run"
+    details = {
+        "driver": driver,
+        "parallel_compile": runs["first"][0]["parallel_compile"],
+        "program_binary_formats": runs["first"][0]["binary_formats"],
+        "scene": f"analytic cut cube 64^3, one cut field, {WIDTH}x{WIDTH}, GPU path requested",
+        "build_s": {kind: [round(run["build_s"], 4) for run in values] for kind, values in runs.items()},
+        "loaded_from_cache": {kind: [run["loaded_from_cache"] for run in values] for kind, values in runs.items()},
+        "first_frame_s": {kind: round(median(kind, "first_frame_s"), 4) for kind in runs},
+        "next_frame_s": round(median("first", "second_frame_s"), 4),
+        "feature_sets": features,
+    }
+    results = [
+        measurement("second start, program binary from our on-disk cache and Mesa's shader cache warm: build + first image",
+                    median("cached"), "s", baseline, first, repeats, machine),
+        measurement("second start, our program cache off, Mesa's shader cache warm: build + first image",
+                    median("mesa_only"), "s", baseline, first, repeats, machine),
+        measurement("second start, program binary from our cache, Mesa's shader cache empty: build + first image",
+                    median("ours_only"), "s", baseline, first, repeats, machine),
+    ]
+    for result in results:
+        result["details"] = details
+    return results
