@@ -318,6 +318,57 @@ public:
         weight = label == 0 ? 0.0 : 1.0;
         return label;
       }
+      // A cell where segments meet (every surface's border search lands in
+      // one): the weighing below without fractions, summed in the same
+      // order, so that it decides exactly as StrongestLabel does.
+      const vtkIdType offsets[8] = { 0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1 };
+      int labels[8];
+      double weights[8];
+      for (int corner = 0; corner < 8; ++corner)
+      {
+        labels[corner] = l[offsets[corner]];
+        weights[corner] =
+          ((corner & 1) ? f[0] : 1.0 - f[0]) * (((corner >> 1) & 1) ? f[1] : 1.0 - f[1]) * (((corner >> 2) & 1) ? f[2] : 1.0 - f[2]);
+      }
+      const vtkIdType first = base[0] + base[1] * sy + base[2] * sz;
+      double unlabelledBright = 0.0;
+      int best = 0;
+      weight = 0.0;
+      for (int corner = 0; corner < 8; ++corner)
+      {
+        const int candidate = labels[corner];
+        if (candidate == 0)
+        {
+          if (scene.AnyIsoSegment && scene.Values[first + offsets[corner]] >= scene.MinimumIso)
+          {
+            unlabelledBright += weights[corner];
+          }
+          continue;
+        }
+        bool seen = false;
+        for (int earlier = 0; earlier < corner && !seen; ++earlier)
+        {
+          seen = labels[earlier] == candidate;
+        }
+        if (seen)
+        {
+          continue;
+        }
+        double sum = 0.0;
+        for (int later = corner; later < 8; ++later)
+        {
+          if (labels[later] == candidate)
+          {
+            sum += weights[later];
+          }
+        }
+        if (sum > weight || (sum == weight && weight > 0.0 && candidate < best))
+        {
+          best = candidate;
+          weight = sum;
+        }
+      }
+      return unlabelledBright > weight ? 0 : best;
     }
     double unlabelledBright = 0.0;
     const int best = this->StrongestLabel(
