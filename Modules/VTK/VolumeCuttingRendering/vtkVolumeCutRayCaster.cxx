@@ -242,48 +242,37 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
       }
       continue;
     }
+    // Where nothing can show ahead, the ray jumps to the last sample on its
+    // sample grid before it may (the samples stay where a march without the
+    // jump puts them, so that the same grazing rays catch a surface's rim as
+    // on the GPU):
+    double clearUntil = a.T;
     if (a.Object == 0)
     {
-      // Through cells where nothing visible can be, to the last sample
-      // before the next cell that may hold a surface: the samples stay where
-      // a march without the jump puts them, so that the same grazing rays
-      // catch a surface's rim as on the GPU.
-      const double entry = emptySpace.ExitEmptyCells(a.Index, d, a.T, tEnd);
-      const double landing = a.T + std::floor((std::min(entry, tEnd) - a.T) / step) * step;
-      if (landing > a.T + step)
-      {
-        a = vtkVolumeCutSample::At(o, d, landing);
-        classifier.EvaluateObject(a);
-        insideVisible = classifier.Visible(a);
-        if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
-        {
-          return;
-        }
-        continue;
-      }
+      // through cells where nothing visible can be, to the next that may
+      // hold a surface;
+      clearUntil = emptySpace.ExitEmptyCells(a.Index, d, a.T, tEnd);
     }
     else if (!insideVisible && a.CutsKnown)
     {
-      // Deep in a cavity: the cut fields are distances (1 mm per mm), so
-      // nothing is visible within the removed depth of this sample; the
-      // ray crosses it on its sample grid without classifying.
-      double removedDepth = 0.0;
+      // deep in a cavity, across the removed depth of this sample (the cut
+      // fields are distances, 1 mm per mm).
       for (size_t n = 0; n < scene.CutFields.size(); ++n)
       {
-        removedDepth = std::max(removedDepth, -a.Distance[n]);
+        clearUntil = std::max(clearUntil, a.T - a.Distance[n]);
       }
-      const double landing = a.T + std::floor(std::min(removedDepth, tEnd - a.T) / step) * step;
-      if (landing > a.T + step)
+    }
+    const double landing = a.T + std::floor((std::min(clearUntil, tEnd) - a.T) / step) * step;
+    if (landing > a.T + step)
+    {
+      a = vtkVolumeCutSample::At(o, d, landing);
+      classifier.EvaluateObject(a);
+      insideVisible = classifier.Visible(a);
+      if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
       {
-        a = vtkVolumeCutSample::At(o, d, landing);
-        classifier.EvaluateObject(a);
-        insideVisible = classifier.Visible(a);
-        if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
-        {
-          return;
-        }
-        continue;
+        return;
       }
+      continue;
     }
     vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
     classifier.EvaluateObject(b);
