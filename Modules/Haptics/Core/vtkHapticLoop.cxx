@@ -26,6 +26,11 @@
 #include <pthread.h>
 #include <sched.h>
 #endif
+#if defined(_WIN32)
+#include <windows.h>
+#else
+#include <time.h>
+#endif
 
 vtkStandardNewMacro(vtkHapticLoop);
 
@@ -60,6 +65,25 @@ struct Display
   int Drilling;
   double ContactDepth;
 };
+
+/// Processor time (us) the calling thread has used: what a tick costs when
+/// the shared machine's other jobs do not preempt it.
+double ThreadProcessorMicroseconds()
+{
+#if defined(_WIN32)
+  FILETIME creation, exit, kernel, user;
+  if (!GetThreadTimes(GetCurrentThread(), &creation, &exit, &kernel, &user))
+  {
+    return 0.0;
+  }
+  const auto hundreds = [](const FILETIME& time) { return (static_cast<unsigned long long>(time.dwHighDateTime) << 32) | time.dwLowDateTime; };
+  return 0.1 * static_cast<double>(hundreds(kernel) + hundreds(user));
+#else
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
+#endif
+}
 
 /// A hint to the processor inside a wait loop.
 inline void Relax()
@@ -120,6 +144,7 @@ struct vtkHapticLoop::Internals
 
   // Statistics: written by the haptic thread, read while stopped.
   std::vector<float> Durations;
+  std::vector<float> ProcessorDurations;
   std::vector<float> Jitters;
   std::atomic<unsigned long long> Timed{ 0 };
   std::atomic<unsigned long long> Jittered{ 0 };
@@ -383,6 +408,7 @@ bool vtkHapticLoop::Prepare()
     internal.Recorder->SetRate(this->Rate);
   }
   internal.Durations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
+  internal.ProcessorDurations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.Jitters.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.Timed = 0;
   internal.Jittered = 0;
@@ -471,9 +497,11 @@ bool vtkHapticLoop::RunTicks(int count)
   for (int n = 0; n < count; ++n)
   {
     const Clock::time_point start = Clock::now();
+    const double processorStart = ThreadProcessorMicroseconds();
     this->Tick(timeStep);
     const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
     internal.Durations[timed % internal.Durations.size()] = std::chrono::duration<float, std::micro>(Clock::now() - start).count();
+    internal.ProcessorDurations[timed % internal.Durations.size()] = static_cast<float>(ThreadProcessorMicroseconds() - processorStart);
     internal.Timed.store(timed + 1, std::memory_order_release);
   }
   return true;
@@ -512,10 +540,12 @@ void vtkHapticLoop::Run()
     }
     previousStart = start;
     hasPrevious = true;
+    const double processorStart = ThreadProcessorMicroseconds();
     this->Tick(timeStep);
     const Clock::time_point end = Clock::now();
     const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
     internal.Durations[timed % capacity] = std::chrono::duration<float, std::micro>(end - start).count();
+    internal.ProcessorDurations[timed % capacity] = static_cast<float>(ThreadProcessorMicroseconds() - processorStart);
     internal.Timed.store(timed + 1, std::memory_order_release);
     deadline += period;
     if (end > deadline)
@@ -844,6 +874,14 @@ double vtkHapticLoop::GetTickDurationPercentile(double percent) const
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.Durations.size());
   return Percentile(std::vector<float>(internal.Durations.begin(), internal.Durations.begin() + count), percent);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetTickProcessorTimePercentile(double percent) const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.ProcessorDurations.size());
+  return Percentile(std::vector<float>(internal.ProcessorDurations.begin(), internal.ProcessorDurations.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------

@@ -206,12 +206,15 @@ public:
   ///@{
   /**
    * Timing of the ticks kept (see StatisticsCapacity), in microseconds:
-   * percentiles (0-100) and maximum of a tick's duration and of the
-   * deviation of the period from 1 / Rate; ticks whose work took longer
-   * than a period. Read them while stopped.
+   * percentiles (0-100) and maximum of a tick's duration (wall time), the
+   * percentiles of the processor time the haptic thread spent in a tick
+   * (its own CPU clock: the wall time less preemption by other threads),
+   * and of the deviation of the period from 1 / Rate; ticks whose work took
+   * longer than a period. Read them while stopped.
    */
   unsigned long long GetNumberOfTicks() const;
   double GetTickDurationPercentile(double percent) const;
+  double GetTickProcessorTimePercentile(double percent) const;
   double GetMaximumTickDuration() const;
   double GetPeriodJitterPercentile(double percent) const;
   double GetMaximumPeriodJitter() const;

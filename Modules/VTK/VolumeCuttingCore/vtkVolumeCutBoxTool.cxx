@@ -71,6 +71,15 @@ double vtkVolumeCutBoxTool::GetBoundingRadius()
 }
 
 //------------------------------------------------------------------------------
+void vtkVolumeCutBoxTool::GetLocalHalfExtents(double halfExtents[3])
+{
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    halfExtents[axis] = 0.5 * this->Size[axis];
+  }
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutBoxTool::IsValid()
 {
   for (double edge : this->Size)

@@ -38,6 +38,14 @@ double vtkVolumeCutCylinderTool::GetBoundingRadius()
 }
 
 //------------------------------------------------------------------------------
+void vtkVolumeCutCylinderTool::GetLocalHalfExtents(double halfExtents[3])
+{
+  halfExtents[0] = this->Radius;
+  halfExtents[1] = this->Radius;
+  halfExtents[2] = 0.5 * this->Length;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutCylinderTool::IsLeftBehind(const double center[3], double radius, const double motion[3])
 {
   // Every (sub)gradient of the distance is a radial unit vector times

@@ -33,6 +33,7 @@ public:
   double EvaluateDistance(const double local[3]) override;
   VTK_WRAPEXCLUDE void EvaluateDistances(const float* x, const float* y, const float* z, int count, float* distances) override;
   double GetBoundingRadius() override;
+  void GetLocalHalfExtents(double halfExtents[3]) override;
   bool IsValid() override;
   bool IsLeftBehind(const double center[3], double radius, const double motion[3]) override;
   VTK_WRAPEXCLUDE bool EvaluateTranslatedDistances(

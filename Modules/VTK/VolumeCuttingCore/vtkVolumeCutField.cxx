@@ -1049,12 +1049,11 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
             bool changed;
             if (whole)
             {
-              const int16_t* current = brick ? brick->WriterView() + rowStart : nullptr;
-              changed = false;
-              for (int n = 0; n < BrickSize; ++n)
-              {
-                changed |= merged[rowStart + n] != (current ? current[n] : Outside);
-              }
+              // A row of 16-bit samples compared as one block: a per-sample
+              // loop here cost as much as the merge.
+              static const int16_t outsideRow[BrickSize] = { Outside, Outside, Outside, Outside, Outside, Outside, Outside, Outside };
+              const int16_t* current = brick ? brick->WriterView() + rowStart : outsideRow;
+              changed = std::memcmp(merged + rowStart, current, sizeof(outsideRow)) != 0;
             }
             else
             {

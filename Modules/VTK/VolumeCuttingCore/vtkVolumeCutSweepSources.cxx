@@ -222,20 +222,32 @@ SweptToolSource::SweptToolSource(
     float distance = 0.0f;
     this->ClosedForm = tool->EvaluateTranslatedDistances(this->Motion, step, &origin, &origin, &origin, 1, &distance);
   }
+  tool->GetLocalHalfExtents(this->HalfExtents);
   this->Meeting.assign(this->Poses.size(), 0);
 }
 
 //------------------------------------------------------------------------------
 void SweptToolSource::GetReachBounds(double lower[3], double upper[3]) const
 {
+  // Each copy's local box, turned into the grid's axes, plus the band (and
+  // Meets' margin for rounding): no sample outside it comes within the band.
   for (int axis = 0; axis < 3; ++axis)
   {
     lower[axis] = std::numeric_limits<double>::max();
     upper[axis] = -std::numeric_limits<double>::max();
-    for (const RigidPose& pose : this->Poses)
+  }
+  for (const RigidPose& pose : this->Poses)
+  {
+    for (int axis = 0; axis < 3; ++axis)
     {
-      lower[axis] = std::min(lower[axis], pose.Translation[axis] - this->Reach);
-      upper[axis] = std::max(upper[axis], pose.Translation[axis] + this->Reach);
+      double extent = this->Band + 1e-3;
+      for (int column = 0; column < 3; ++column)
+      {
+        extent += std::abs(pose.Rotation[axis][column]) * this->HalfExtents[column];
+      }
+      extent = std::min(extent, this->Reach);
+      lower[axis] = std::min(lower[axis], pose.Translation[axis] - extent);
+      upper[axis] = std::max(upper[axis], pose.Translation[axis] + extent);
     }
   }
 }
@@ -263,11 +275,19 @@ const std::vector<char>& SweptToolSource::Copies(const double center[3], double 
     }
     if (this->ClosedForm && !behind)
     {
-      // Every point of a translated sweep is within half the motion of the
-      // first or the last copy: those two bound the whole sweep's reach (the
-      // copies of the closed form's path need no test of their own).
-      const double halfMotion = 0.5 * std::sqrt(this->Motion[0] * this->Motion[0] + this->Motion[1] * this->Motion[1] + this->Motion[2] * this->Motion[2]);
-      const bool reaches = this->Meets(this->Poses.front(), center, radius + halfMotion) || this->Meets(this->Poses.back(), center, radius + halfMotion);
+      // The closed form's own distance at the centre, less the ball's
+      // radius, bounds the sweep's distance below over the ball (a minimum
+      // of distances changes no faster than the point moves), as in Meets.
+      const RigidPose& first = this->Poses.front();
+      const double w[3] = { center[0] - first.Translation[0], center[1] - first.Translation[1], center[2] - first.Translation[2] };
+      float local[3];
+      for (int row = 0; row < 3; ++row)
+      {
+        local[row] = static_cast<float>(first.Rotation[0][row] * w[0] + first.Rotation[1][row] * w[1] + first.Rotation[2][row] * w[2]);
+      }
+      float distance = 0.0f;
+      this->Tool->EvaluateTranslatedDistances(this->Motion, this->Step, &local[0], &local[1], &local[2], 1, &distance);
+      const bool reaches = distance - radius <= this->Band + 1e-3;
       for (size_t n = this->FirstCopy; n < this->Poses.size(); ++n)
       {
         this->Meeting[n] = reaches ? 1 : 0;

@@ -93,6 +93,7 @@ private:
   std::vector<RigidPose> Poses;
   double Band;
   double Reach;
+  double HalfExtents[3];
   size_t FirstCopy;
   double Step;
   bool Translation = false;

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutTool.h"
 
+#include <algorithm>
+
 //------------------------------------------------------------------------------
 void vtkVolumeCutTool::PrintSelf(ostream& os, vtkIndent indent)
 {
@@ -16,6 +18,13 @@ void vtkVolumeCutTool::EvaluateDistances(const float* x, const float* y, const f
     const double local[3] = { x[n], y[n], z[n] };
     distances[n] = static_cast<float>(this->EvaluateDistance(local));
   }
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutTool::GetLocalHalfExtents(double halfExtents[3])
+{
+  const double radius = this->GetBoundingRadius();
+  std::fill(halfExtents, halfExtents + 3, radius);
 }
 
 //------------------------------------------------------------------------------

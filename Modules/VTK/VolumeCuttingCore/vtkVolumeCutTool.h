@@ -40,6 +40,13 @@ public:
   /// Radius (mm) of a sphere about the local origin that holds the tool.
   virtual double GetBoundingRadius() = 0;
 
+  /// Half sizes (mm) of a box about the local origin, along the local axes,
+  /// that holds the tool. The cut field's writer visits only the bricks near
+  /// the box's copies, so a flat tool (a disk saw) need not pay for the cube
+  /// around its bounding sphere. The default, the bounding radius on each
+  /// axis, is always safe.
+  virtual void GetLocalHalfExtents(double halfExtents[3]);
+
   /**
    * Whether the ball of the given radius about center (tool frame, mm) is
    * left behind when the tool translates by any positive multiple of motion

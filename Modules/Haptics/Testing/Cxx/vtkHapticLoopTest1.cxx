@@ -289,6 +289,12 @@ int vtkHapticLoopTest1(int argc, char* argv[])
             << loop->GetPeriodJitterPercentile(99) << " us" << (loop->GetRealTimePriority() ? " (real-time priority)" : "") << std::endl;
   CHECK_BOOL(loop->GetNumberOfTicks() > 30, true);
   CHECK_BOOL(loop->GetTickDurationPercentile(50) > 0.0, true);
+  // The thread's processor time within a tick: some, and no more than the
+  // tick's wall time (a microsecond allowed for the clocks' own reading).
+  std::cout << "tick processor time p50 " << loop->GetTickProcessorTimePercentile(50) << " us, max " << loop->GetTickProcessorTimePercentile(100)
+            << " us" << std::endl;
+  CHECK_BOOL(loop->GetTickProcessorTimePercentile(50) > 0.0, true);
+  CHECK_BOOL(loop->GetTickProcessorTimePercentile(100) <= loop->GetMaximumTickDuration() + 1.0, true);
   loop->Print(std::cout);
   return EXIT_SUCCESS;
 }
