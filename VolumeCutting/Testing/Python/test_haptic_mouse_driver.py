@@ -9,6 +9,7 @@ cuts, and the session's Update moves the tool node at display rate.
 
 import math
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -60,14 +61,15 @@ def world_to_device(session):
     return world_to_device
 
 
-def test_the_mouse_moves_the_tool_and_its_left_button_drills():
+def drive_with_the_mouse(scale, wheel_step):
+    """The block scene, a session started with a virtual device, and the view's mouse driving it."""
     application, logic, cut = block_scene()
     tool = add_burr(application.scene, cut)
     place(tool, START)
     device = slicer.vtkVirtualHapticDevice()
     session = slicer.vtkSlicerVolumeCuttingHapticSession()
     session.SetLogic(logic)
-    session.SetDeviceScale(2.0)
+    session.SetDeviceScale(scale)
     renderer, window, interactor = view()
     driver = slicer.vtkVirtualHapticDeviceMouseDriver()
     assert session.Start(cut, device)
@@ -76,10 +78,31 @@ def test_the_mouse_moves_the_tool_and_its_left_button_drills():
         driver.SetInteractor(interactor)
         driver.SetDefaultRenderer(renderer)
         driver.SetDevice(device)
-        driver.SetWheelStep(1.0)
+        driver.SetWheelStep(wheel_step)
         driver.SetEnabled(1)
         assert driver.GetEnabled()
+    except BaseException:
+        session.Stop()
+        raise
+    return SimpleNamespace(
+        logic=logic,
+        cut=cut,
+        tool=tool,
+        device=device,
+        session=session,
+        renderer=renderer,
+        window=window,
+        interactor=interactor,
+        driver=driver,
+    )
 
+
+def test_the_mouse_moves_the_tool_and_its_left_button_drills():
+    view_session = drive_with_the_mouse(scale=2.0, wheel_step=1.0)
+    logic, cut, tool = view_session.logic, view_session.cut, view_session.tool
+    device, session, driver = view_session.device, view_session.session, view_session.driver
+    renderer, interactor = view_session.renderer, view_session.interactor
+    try:
         # The tool follows the cursor on the plane x = -14 facing the camera.
         # Looking along +x with z up, the view's right is -y; the expectation
         # is the perspective camera's analytic projection. In air the loop's
@@ -143,22 +166,10 @@ def test_the_mouse_moves_the_tool_and_its_left_button_drills():
 
 
 def test_the_workspace_bounds_the_mouse():
-    application, logic, cut = block_scene()
-    tool = add_burr(application.scene, cut)
-    place(tool, START)
-    device = slicer.vtkVirtualHapticDevice()
-    session = slicer.vtkSlicerVolumeCuttingHapticSession()
-    session.SetLogic(logic)
-    renderer, window, interactor = view()
-    driver = slicer.vtkVirtualHapticDeviceMouseDriver()
-    assert session.Start(cut, device)
+    view_session = drive_with_the_mouse(scale=1.0, wheel_step=5.0)
+    tool, device, session = view_session.tool, view_session.device, view_session.session
+    interactor, driver = view_session.interactor, view_session.driver
     try:
-        driver.SetWorldToDevice(world_to_device(session))
-        driver.SetInteractor(interactor)
-        driver.SetDefaultRenderer(renderer)
-        driver.SetDevice(device)
-        driver.SetWheelStep(5.0)
-        driver.SetEnabled(1)
         # 20 notches of 5 mm towards the viewer ask for 100 mm; the Falcon-like workspace is 40 mm.
         for _ in range(20):
             event(interactor, "MouseWheelBackwardEvent", SIZE // 2, SIZE // 2)
