@@ -1321,7 +1321,52 @@ double vtkVolumeCutField::Interpolate(const double index[3], SampleReader&& read
 //------------------------------------------------------------------------------
 double vtkVolumeCutField::InterpolateAtIndex(const double index[3]) const
 {
-  return this->Interpolate(index, [this](int i, int j, int k) { return this->ReadSample(i, j, k); });
+  // One interpolation reads up to 56 samples (8 corners and their curvature
+  // neighbours), all in the 4x4x4 block around the cell, which spans at most
+  // 2x2x2 bricks: their pointers and each row's offsets are looked up once,
+  // so a read is two table lookups and a load, with the value ReadSample gives.
+  const int first[3] = { static_cast<int>(std::floor(index[0])) - 1, static_cast<int>(std::floor(index[1])) - 1,
+    static_cast<int>(std::floor(index[2])) - 1 };
+  const bool blockInside = this->Directory && first[0] >= 0 && first[1] >= 0 && first[2] >= 0 &&
+    first[0] + 3 < this->Dimensions[0] && first[1] + 3 < this->Dimensions[1] && first[2] + 3 < this->Dimensions[2];
+  if (!blockInside)
+  {
+    return this->Interpolate(index, [this](int i, int j, int k) { return this->ReadSample(i, j, k); });
+  }
+  int brickOf[3][4];
+  int offsetOf[3][4];
+  int brickCount[3];
+  constexpr int strides[3] = { 1, BrickSize, BrickSize * BrickSize };
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const int firstBrick = first[axis] / BrickSize;
+    for (int n = 0; n < 4; ++n)
+    {
+      brickOf[axis][n] = (first[axis] + n) / BrickSize - firstBrick;
+      offsetOf[axis][n] = ((first[axis] + n) % BrickSize) * strides[axis];
+    }
+    brickCount[axis] = brickOf[axis][3] + 1;
+  }
+  const Brick* bricks[2][2][2] = {};
+  for (int dk = 0; dk < brickCount[2]; ++dk)
+  {
+    for (int dj = 0; dj < brickCount[1]; ++dj)
+    {
+      for (int di = 0; di < brickCount[0]; ++di)
+      {
+        const vtkIdType brickId = (static_cast<vtkIdType>(first[2] / BrickSize + dk) * this->BrickDimensions[1] + first[1] / BrickSize + dj) *
+            this->BrickDimensions[0] + first[0] / BrickSize + di;
+        bricks[dk][dj][di] = this->Directory[brickId].load(std::memory_order_acquire);
+      }
+    }
+  }
+  return this->Interpolate(index, [&](int i, int j, int k) -> int16_t {
+    const int a = i - first[0];
+    const int b = j - first[1];
+    const int c = k - first[2];
+    const Brick* brick = bricks[brickOf[2][c]][brickOf[1][b]][brickOf[0][a]];
+    return brick ? brick->Values[offsetOf[0][a] + offsetOf[1][b] + offsetOf[2][c]].load(std::memory_order_relaxed) : Outside;
+  });
 }
 
 //------------------------------------------------------------------------------
