@@ -307,11 +307,22 @@ void vtkHapticForceModel::Reset(const double position[3])
 //------------------------------------------------------------------------------
 bool vtkHapticForceModel::IsSolid(const double ras[3]) const
 {
-  const Internals& internal = *this->Internal;
-  if (!internal.Prepared)
+  if (!this->Internal->Prepared)
   {
     return false;
   }
+  Margins margins;
+  this->Measure(ras, margins);
+  return margins.IsSolid();
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticForceModel::Measure(const double ras[3], Margins& margins) const
+{
+  const Internals& internal = *this->Internal;
+  margins.Anatomy = -1.0;
+  margins.Removal = VTK_DOUBLE_MAX;
+  margins.InBox = false;
   double ijk[3];
   for (int row = 0; row < 3; ++row)
   {
@@ -320,41 +331,164 @@ bool vtkHapticForceModel::IsSolid(const double ras[3]) const
     // Outside the volume's box there is nothing to touch (the renderer stops there too).
     if (!(ijk[row] >= 0.0 && ijk[row] <= internal.Dimensions[row] - 1.0))
     {
-      return false;
+      return;
     }
   }
-  if (internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) < this->SurfaceIsoValue)
+  margins.InBox = true;
+  margins.Anatomy = internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) - this->SurfaceIsoValue;
+  // The cut field costs several times the CT's lookup: only where the CT is solid.
+  if (this->CutField && !(margins.Anatomy < 0.0))
   {
-    return false;
+    margins.Removal = this->CutField->GetSignedDistance(ras);
   }
-  return !this->CutField || !(this->CutField->GetSignedDistance(ras) < 0.0);
 }
 
 //------------------------------------------------------------------------------
-double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length) const
+double vtkHapticForceModel::AnatomyMargin(const double ras[3]) const
+{
+  const Internals& internal = *this->Internal;
+  double ijk[3];
+  for (int row = 0; row < 3; ++row)
+  {
+    ijk[row] = internal.RASToIJK[row][0] * ras[0] + internal.RASToIJK[row][1] * ras[1] + internal.RASToIJK[row][2] * ras[2] +
+      internal.RASToIJK[row][3];
+  }
+  return internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) - this->SurfaceIsoValue;
+}
+
+namespace
+{
+/// Where margin(t) falls below zero between a (margin >= 0) and b (margin <
+/// 0), to within tolerance: Illinois regula falsi. Both margins (CT less the
+/// iso-value, the cut field's distance) are smooth across the half-voxel
+/// bracket, so this takes 2-4 evaluations where halving takes 8.
+template <typename Margin>
+double FindBorder(Margin&& margin, double a, double marginA, double b, double marginB, double tolerance)
+{
+  int keptSide = 0;
+  for (int iteration = 0; iteration < 16 && b - a > tolerance; ++iteration)
+  {
+    const double slope = (marginA - marginB) / (b - a);
+    double t = a + marginA / slope;
+    if (!(t > a && t < b))
+    {
+      t = 0.5 * (a + b);
+    }
+    const double value = margin(t);
+    // Where the margin is this small, the border is within half the
+    // tolerance of t along the bracket's slope.
+    if (std::abs(value) <= 0.5 * tolerance * slope)
+    {
+      return t;
+    }
+    if (!(value < 0.0))
+    {
+      a = t;
+      marginA = value;
+      if (keptSide == 1)
+      {
+        marginB *= 0.5;
+      }
+      keptSide = 1;
+    }
+    else
+    {
+      b = t;
+      marginB = value;
+      if (keptSide == -1)
+      {
+        marginA *= 0.5;
+      }
+      keptSide = -1;
+    }
+  }
+  return 0.5 * (a + b);
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart) const
 {
   const double step = this->Internal->TraceStep;
+  // 1/256 of a step (a step is half a voxel): far inside the 0.1 voxel the
+  // force must agree with the picture.
+  const double tolerance = step / 256.0;
   double inside = 0.0;
-  for (double t = std::min(step, length);; t = std::min(t + step, length))
+  Margins last = atStart;
+  // The cut field is a distance (mm): where it is nearer than a step, the
+  // trace most likely leaves there (exactly so for a cut surface facing the
+  // trace, as in the burr's own cavity), so the first sample is taken just
+  // beyond it and brackets the border with one lookup.
+  double first = step;
+  if (atStart.Removal < step)
+  {
+    first = std::max(1.05 * atStart.Removal + tolerance, tolerance);
+  }
+  for (double t = std::min(first, length);; t = std::min(t + step, length))
   {
     const double q[3] = { p[0] + t * u[0], p[1] + t * u[1], p[2] + t * u[2] };
-    if (!this->IsSolid(q))
+    Margins here;
+    this->Measure(q, here);
+    if (!here.IsSolid())
     {
-      // The border lies between the last solid sample and this one: 8
-      // halvings put it within 1/256 of a step (a step is half a voxel),
-      // far inside the 0.1 voxel the force must agree with the picture;
-      // each halving is a lookup in both fields for each immersed point in
-      // every proxy iteration of every tick.
-      double outside = t;
-      for (int halving = 0; halving < 8; ++halving)
+      auto at = [p, u](double s, double point[3]) {
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          point[axis] = p[axis] + s * u[axis];
+        }
+      };
+      if (!here.InBox)
       {
-        const double middle = 0.5 * (inside + outside);
-        const double m[3] = { p[0] + middle * u[0], p[1] + middle * u[1], p[2] + middle * u[2] };
-        (this->IsSolid(m) ? inside : outside) = middle;
+        // Left the volume's box (convex, so between the two samples only
+        // once): halve on the classification itself.
+        double outside = t;
+        for (int halving = 0; halving < 8; ++halving)
+        {
+          const double middle = 0.5 * (inside + outside);
+          double m[3];
+          at(middle, m);
+          (this->IsSolid(m) ? inside : outside) = middle;
+        }
+        return 0.5 * (inside + outside);
       }
-      return 0.5 * (inside + outside);
+      double exit = t;
+      if (here.Anatomy < 0.0)
+      {
+        exit = FindBorder(
+          [&](double s) {
+            double m[3];
+            at(s, m);
+            return this->AnatomyMargin(m);
+          },
+          inside, last.Anatomy, t, here.Anatomy, tolerance);
+        if (!this->CutField)
+        {
+          return exit;
+        }
+        // The cut may end the material before the CT does.
+        double m[3];
+        at(exit - tolerance, m);
+        here.Removal = this->CutField->GetSignedDistance(m);
+        if (!(here.Removal < 0.0))
+        {
+          return exit;
+        }
+        t = exit - tolerance;
+      }
+      if (!(t > inside))
+      {
+        return inside;
+      }
+      return FindBorder(
+        [&](double s) {
+          double m[3];
+          at(s, m);
+          return this->CutField->GetSignedDistance(m);
+        },
+        inside, last.Removal, t, here.Removal, tolerance);
     }
     inside = t;
+    last = here;
     if (t >= length)
     {
       return length;
@@ -377,7 +511,9 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
       offset[row] = rotation[row][0] * local[0] + rotation[row][1] * local[1] + rotation[row][2] * local[2];
     }
     const double p[3] = { position[0] + offset[0], position[1] + offset[1], position[2] + offset[2] };
-    if (!this->IsSolid(p))
+    Margins margins;
+    this->Measure(p, margins);
+    if (!margins.IsSolid())
     {
       continue;
     }
@@ -389,7 +525,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
       continue;
     }
     const double u[3] = { -offset[0] / length, -offset[1] / length, -offset[2] / length };
-    const double depth = this->ExitDistance(p, u, length);
+    const double depth = this->ExitDistance(p, u, length, margins);
     for (int axis = 0; axis < 3; ++axis)
     {
       force[axis] += this->ContactStiffness * depth * u[axis];

@@ -11,7 +11,8 @@
  * not negative. The tool is sampled by a point shell (vtkHapticPointShell,
  * 82 points by default, seed 003); every shell point inside solid material
  * traces toward the tool's centre to where the material ends (steps of half
- * the finest grid spacing, then bisection) and pushes the tool out along
+ * the finest grid spacing, the first one guided by the cut field's distance,
+ * then regula falsi on the CT or the cut field) and pushes the tool out along
  * that line with ContactStiffness times the depth.
  *
  * Proxy. Those penalty forces act on a proxy of the tool (god-object,
@@ -298,8 +299,20 @@ protected:
 
   /// Penalty force of the shell at a pose; returns the number of contacts.
   int Contact(const double position[3], const double rotation[3][3], double force[3]) const;
-  /// Distance from p (in material) along unit u to where the material ends, at most length.
-  double ExitDistance(const double p[3], const double u[3], double length) const;
+  /// What makes a point solid: the CT above the iso-value and the cut
+  /// field not removed there (the renderer's classification).
+  struct Margins
+  {
+    double Anatomy;  ///< CT less the iso-value (solid when not negative)
+    double Removal;  ///< the cut field's signed distance (mm; removed when negative), measured only where the CT is solid
+    bool InBox;      ///< inside the CT's box
+    bool IsSolid() const { return this->InBox && !(this->Anatomy < 0.0) && !(this->Removal < 0.0); }
+  };
+  void Measure(const double ras[3], Margins& margins) const;
+  /// The CT less the iso-value at a point known to be inside the CT's box.
+  double AnatomyMargin(const double ras[3]) const;
+  /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length.
+  double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart) const;
 
   vtkSmartPointer<vtkImageData> Anatomy;
   vtkSmartPointer<vtkMatrix4x4> AnatomyIJKToRAS;
