@@ -1,7 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 // The force model against analytic scenes: a spherical burr pressed into a
-// plane and into a hole cut in it. Force starts where the shell touches the
+// plane, into a hole cut in it, and against the wall of a cavity cut in it. Force starts where the shell touches the
 // surface the renderer draws (the CT's iso-surface minus the cut field), to
 // well within 0.1 voxel; the proxy stays on the surface; limits, guide,
 // drilling bite, vibration and bad input behave.
@@ -247,6 +247,63 @@ int vtkHapticForceModelTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   const double clear[3] = { 5.0, 5.0, scene.PlaneHeight + radius + scene.Spacing + 0.01 };
   CHECK_BOOL(model->CountWholeVoxelContacts(deep, removed) > 0, true);
   CHECK_INT(model->CountWholeVoxelContacts(clear, removed), 0);
+
+  // 11. A spherical cavity cut deep in the material: the burr pressed against
+  // its wall meets the cut field, not the CT. Each immersed point's depth is
+  // where its trace toward the centre leaves the material, analytically the
+  // ray's exit into the cavity sphere; the force is their sum.
+  model->SetSphereRadius(radius);
+  CHECK_BOOL(model->Prepare(), true);
+  const double cavity[3] = { 0.3, -0.4, scene.PlaneHeight - 7.0 };
+  const double cavityRadius = 4.0;
+  CHECK_BOOL(scene.Field->CutCapsule(cavity, cavity, cavityRadius), true);
+  // Directions where no shell point lies within 0.02 mm of the wall.
+  const double pushes[4][3] = { { -0.41, 1.59, 0.11 }, { 0.28, 1.61, -0.3 }, { 1.36, 0.61, 0.61 }, { 0.15, -1.61, -0.48 } };
+  for (const auto& push : pushes)
+  {
+    const double center[3] = { cavity[0] + push[0], cavity[1] + push[1], cavity[2] + push[2] };
+    double expectedForce[3] = { 0.0, 0.0, 0.0 };
+    int expectedContacts = 0;
+    double nearestToWall = 1e300;
+    for (int n = 0; n < shell->GetNumberOfPoints(); ++n)
+    {
+      double offset[3];
+      shell->GetPoint(n, offset);
+      const double p[3] = { center[0] + offset[0], center[1] + offset[1], center[2] + offset[2] };
+      const double fromCavity = std::sqrt(vtkMath::Distance2BetweenPoints(p, cavity));
+      nearestToWall = std::min(nearestToWall, std::abs(fromCavity - cavityRadius));
+      if (fromCavity <= cavityRadius)
+      {
+        continue;
+      }
+      // |p + t u - c| = R, the smaller root: where the trace enters the cavity.
+      const double length = vtkMath::Norm(offset);
+      const double u[3] = { -offset[0] / length, -offset[1] / length, -offset[2] / length };
+      const double w[3] = { p[0] - cavity[0], p[1] - cavity[1], p[2] - cavity[2] };
+      const double b = vtkMath::Dot(w, u);
+      const double c = vtkMath::Dot(w, w) - cavityRadius * cavityRadius;
+      const double depth = std::min(-b - std::sqrt(b * b - c), length);
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        expectedForce[axis] += model->GetContactStiffness() * depth * u[axis];
+      }
+      ++expectedContacts;
+    }
+    CHECK_BOOL(nearestToWall > 0.01, true);
+    double cavityForce[3];
+    CHECK_INT(model->ComputeContactForce(center, cavityForce), expectedContacts);
+    // The cut field's reconstruction of the sphere (0.25 mm samples) is good
+    // to a few micrometres; 0.005 mm per contact is 0.01 voxel.
+    const double forceTolerance = model->GetContactStiffness() * 0.005 * expectedContacts;
+    std::cout << "cavity wall: " << expectedContacts << " contacts, force (" << cavityForce[0] << ", " << cavityForce[1] << ", "
+              << cavityForce[2] << ") N, analytic (" << expectedForce[0] << ", " << expectedForce[1] << ", " << expectedForce[2] << ")"
+              << std::endl;
+    CHECK_BOOL(expectedContacts > 0, true);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      CHECK_DOUBLE_TOLERANCE(cavityForce[axis], expectedForce[axis], forceTolerance);
+    }
+  }
 
   // Missing inputs are refused with a reason.
   vtkNew<vtkHapticForceModel> empty;
