@@ -41,15 +41,15 @@ void CapsuleBrickDistances(const float w0[3], const float ab[3], float inverseLe
   }
 }
 
-void ToToolFrame(const float rotation[3][3], const float w0[3], const float* __restrict offsets, float* __restrict x, float* __restrict y,
-  float* __restrict z)
+void ToToolFrame(const float rotation[3][3], const float w0[3], const float* __restrict offsets, int count, float* __restrict x,
+  float* __restrict y, float* __restrict z)
 {
   // Locals: the stores below cannot then be taken to change them.
   const float r00 = rotation[0][0], r01 = rotation[0][1], r02 = rotation[0][2];
   const float r10 = rotation[1][0], r11 = rotation[1][1], r12 = rotation[1][2];
   const float r20 = rotation[2][0], r21 = rotation[2][1], r22 = rotation[2][2];
   const float w0x = w0[0], w0y = w0[1], w0z = w0[2];
-  for (int n = 0; n < SamplesPerBrick; ++n)
+  for (int n = 0; n < count; ++n)
   {
     const float wx = w0x + offsets[n];
     const float wy = w0y + offsets[SamplesPerBrick + n];
