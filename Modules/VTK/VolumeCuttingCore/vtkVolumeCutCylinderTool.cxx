@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 vtkStandardNewMacro(vtkVolumeCutCylinderTool);
 
@@ -89,18 +88,21 @@ bool vtkVolumeCutCylinderTool::EvaluateTranslatedDistances(
   {
     return false;
   }
+  // One piece (a stroke within a haptic frame, usually) needs no divisions:
+  // x / 1 is x.
   const int pieces = TranslationPieces(motion, step);
-  const float segment[2] = { static_cast<float>(motion[0] / pieces), static_cast<float>(motion[1] / pieces) };
+  const float segment[2] = { static_cast<float>(pieces == 1 ? motion[0] : motion[0] / pieces),
+    static_cast<float>(pieces == 1 ? motion[1] : motion[1] / pieces) };
   const double length2 = static_cast<double>(segment[0]) * segment[0] + static_cast<double>(segment[1]) * segment[1];
   const float inverseLength2 = length2 > 0.0 ? static_cast<float>(1.0 / length2) : 0.0f;
   const vtkVolumeCutKernels::Table& kernels = vtkVolumeCutKernels::Get();
-  std::fill(distances, distances + count, std::numeric_limits<float>::max());
   for (int piece = 0; piece < pieces; ++piece)
   {
-    const double start = static_cast<double>(piece) / pieces;
-    const double end = static_cast<double>(piece + 1) / pieces;
+    const double start = pieces == 1 ? 0.0 : static_cast<double>(piece) / pieces;
+    const double end = pieces == 1 ? 1.0 : static_cast<double>(piece + 1) / pieces;
     const float offset[3] = { static_cast<float>(start * motion[0]), static_cast<float>(start * motion[1]), static_cast<float>(end * motion[2]) };
-    kernels.CylinderSweptMinimum(
+    // The first piece stores its distances: the minimum with nothing yet.
+    (piece == 0 ? kernels.CylinderSwept : kernels.CylinderSweptMinimum)(
       static_cast<float>(this->Radius), static_cast<float>(0.5 * this->Length), offset, segment, inverseLength2, x, y, z, count, distances);
   }
   return true;

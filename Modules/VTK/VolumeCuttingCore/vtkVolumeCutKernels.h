@@ -59,6 +59,9 @@ struct Table
   /// segment (x, y), times the slab offset[2] +- halfLength.
   void (*CylinderSweptMinimum)(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
     const float* x, const float* y, const float* z, int count, float* distances);
+  /// The same distances stored, not merged: the first piece of a sweep.
+  void (*CylinderSwept)(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+    const float* x, const float* y, const float* z, int count, float* distances);
 };
 
 /// The kernels of the set in use: the widest this build and processor have,

@@ -142,7 +142,8 @@ void BoxDistances(const float half[3], const float* x, const float* y, const flo
     distances[n] = sqrtf(ox * ox + oy * oy + oz * oz) + (largest < 0.0f ? largest : 0.0f);
   }
 }
-void CylinderSweptMinimum(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+template <bool Minimum>
+void CylinderSweptRun(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
   const float* x, const float* y, const float* z, int count, float* __restrict distances)
 {
   const float ox = offset[0], oy = offset[1], oz = offset[2];
@@ -164,10 +165,29 @@ void CylinderSweptMinimum(float radius, float halfLength, const float offset[3],
     const float outsideAxial = axial > 0.0f ? axial : 0.0f;
     const float larger = radial > axial ? radial : axial;
     const float distance = sqrtf(outsideRadial * outsideRadial + outsideAxial * outsideAxial) + (larger < 0.0f ? larger : 0.0f);
-    distances[n] = distance < distances[n] ? distance : distances[n];
+    if (Minimum)
+    {
+      distances[n] = distance < distances[n] ? distance : distances[n];
+    }
+    else
+    {
+      distances[n] = distance;
+    }
   }
+}
+
+void CylinderSweptMinimum(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+  const float* x, const float* y, const float* z, int count, float* distances)
+{
+  CylinderSweptRun<true>(radius, halfLength, offset, segment, inverseSegmentLength2, x, y, z, count, distances);
+}
+
+void CylinderSwept(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2, const float* x,
+  const float* y, const float* z, int count, float* distances)
+{
+  CylinderSweptRun<false>(radius, halfLength, offset, segment, inverseSegmentLength2, x, y, z, count, distances);
 }
 } // namespace
 
 const vtkVolumeCutKernels::Table vtkVolumeCutKernels::VOLUMECUTTING_KERNELS_TABLE = { CapsuleBrickDistances, ToToolFrame, MergeCopy, QuantizeRun,
-  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances, CylinderSweptMinimum };
+  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances, CylinderSweptMinimum, CylinderSwept };
