@@ -896,16 +896,23 @@ void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16
   std::atomic_thread_fence(std::memory_order_release);
   for (int r = 0; r < runCount; ++r)
   {
-    // A row at a time where whole rows changed: a loop of known length the
-    // compiler unrolls (atomic stores do not vectorise).
+    // A whole row at a time, written out: atomic stores do not vectorise,
+    // and compilers do not unroll a loop of them by themselves.
+    static_assert(BrickSize == 8, "a row is eight samples");
     int n = runs[r].Start;
     const int end = n + runs[r].Count;
     for (; n + BrickSize <= end; n += BrickSize)
     {
-      for (int m = 0; m < BrickSize; ++m)
-      {
-        brick->Values[n + m].store(merged[n + m], std::memory_order_relaxed);
-      }
+      std::atomic<int16_t>* row = brick->Values + n;
+      const int16_t* values = merged + n;
+      row[0].store(values[0], std::memory_order_relaxed);
+      row[1].store(values[1], std::memory_order_relaxed);
+      row[2].store(values[2], std::memory_order_relaxed);
+      row[3].store(values[3], std::memory_order_relaxed);
+      row[4].store(values[4], std::memory_order_relaxed);
+      row[5].store(values[5], std::memory_order_relaxed);
+      row[6].store(values[6], std::memory_order_relaxed);
+      row[7].store(values[7], std::memory_order_relaxed);
     }
     for (; n < end; ++n)
     {
