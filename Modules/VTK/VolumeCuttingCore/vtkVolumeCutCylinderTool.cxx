@@ -7,9 +7,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 vtkStandardNewMacro(vtkVolumeCutCylinderTool);
+
+namespace
+{
+/// Pieces of a translated sweep: its motion along the axis in steps no longer than step.
+int TranslationPieces(const double motion[3], double step)
+{
+  return std::max(1, static_cast<int>(std::ceil(std::abs(motion[2]) / step)));
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 double vtkVolumeCutCylinderTool::EvaluateDistance(const double local[3])
@@ -80,19 +88,74 @@ bool vtkVolumeCutCylinderTool::EvaluateTranslatedDistances(
   {
     return false;
   }
-  const int pieces = std::max(1, static_cast<int>(std::ceil(std::abs(motion[2]) / step)));
-  const float segment[2] = { static_cast<float>(motion[0] / pieces), static_cast<float>(motion[1] / pieces) };
+  // One piece (a stroke within a haptic frame, usually) needs no divisions:
+  // x / 1 is x.
+  const int pieces = TranslationPieces(motion, step);
+  const float segment[2] = { static_cast<float>(pieces == 1 ? motion[0] : motion[0] / pieces),
+    static_cast<float>(pieces == 1 ? motion[1] : motion[1] / pieces) };
   const double length2 = static_cast<double>(segment[0]) * segment[0] + static_cast<double>(segment[1]) * segment[1];
   const float inverseLength2 = length2 > 0.0 ? static_cast<float>(1.0 / length2) : 0.0f;
   const vtkVolumeCutKernels::Table& kernels = vtkVolumeCutKernels::Get();
-  std::fill(distances, distances + count, std::numeric_limits<float>::max());
   for (int piece = 0; piece < pieces; ++piece)
   {
-    const double start = static_cast<double>(piece) / pieces;
-    const double end = static_cast<double>(piece + 1) / pieces;
+    const double start = pieces == 1 ? 0.0 : static_cast<double>(piece) / pieces;
+    const double end = pieces == 1 ? 1.0 : static_cast<double>(piece + 1) / pieces;
     const float offset[3] = { static_cast<float>(start * motion[0]), static_cast<float>(start * motion[1]), static_cast<float>(end * motion[2]) };
-    kernels.CylinderSweptMinimum(
+    // The first piece stores its distances: the minimum with nothing yet.
+    (piece == 0 ? kernels.CylinderSwept : kernels.CylinderSweptMinimum)(
       static_cast<float>(this->Radius), static_cast<float>(0.5 * this->Length), offset, segment, inverseLength2, x, y, z, count, distances);
+  }
+  return true;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutCylinderTool::BoundTranslatedDistances(
+  const double motion[3], double step, const double origin[3], const double stride[3], const double edges[2][3], int count, double* bounds)
+{
+  if (!(step > 0.0) || count < 1)
+  {
+    return false; // no closed form (EvaluateTranslatedDistances)
+  }
+  // Each piece of the closed form is a disk moved along part of the segment
+  // from the origin to motion (x, y), times a slab at one of the pieces'
+  // heights: all lie within the 2D capsule of the whole segment times the
+  // slab spanning those heights. Its distance grows, as a cylinder's, with
+  // a radial and an axial term, each no smaller for a piece than for that
+  // hull. The radial term is bounded once for all slices (their middle less
+  // their spread), the axial one for each slice (its lowest and highest point).
+  const int pieces = TranslationPieces(motion, step);
+  const double halfLength = 0.5 * this->Length;
+  const double lowest = std::min(motion[2] / pieces, motion[2]) - halfLength;
+  const double highest = std::max(motion[2] / pieces, motion[2]) + halfLength;
+  const double middleSlice = 0.5 * (count - 1);
+  double middle[2];
+  double spread2 = 0.0;
+  for (int corner = 0; corner < 4; ++corner)
+  {
+    const double u = corner & 1 ? 0.5 : -0.5;
+    const double v = corner & 2 ? 0.5 : -0.5;
+    double offset[2];
+    for (int axis = 0; axis < 2; ++axis)
+    {
+      middle[axis] = origin[axis] + middleSlice * stride[axis] + 0.5 * (edges[0][axis] + edges[1][axis]);
+      offset[axis] = u * edges[0][axis] + v * edges[1][axis] + middleSlice * stride[axis];
+    }
+    spread2 = std::max(spread2, offset[0] * offset[0] + offset[1] * offset[1]);
+  }
+  const double segmentLength2 = motion[0] * motion[0] + motion[1] * motion[1];
+  double along = segmentLength2 > 0.0 ? (middle[0] * motion[0] + middle[1] * motion[1]) / segmentLength2 : 0.0;
+  along = std::min(1.0, std::max(0.0, along));
+  const double dx = middle[0] - along * motion[0];
+  const double dy = middle[1] - along * motion[1];
+  const double radial = std::sqrt(dx * dx + dy * dy) - std::sqrt(spread2) - this->Radius;
+  const double below = std::min(0.0, edges[0][2]) + std::min(0.0, edges[1][2]);
+  const double above = std::max(0.0, edges[0][2]) + std::max(0.0, edges[1][2]);
+  for (int s = 0; s < count; ++s)
+  {
+    const double base = origin[2] + s * stride[2];
+    const double axial = std::max(lowest - (base + above), base + below - highest);
+    // The cylinder's combination of the terms, which grows with each.
+    bounds[s] = radial > 0.0 && axial > 0.0 ? std::sqrt(radial * radial + axial * axial) : std::max(radial, axial);
   }
   return true;
 }

@@ -38,6 +38,8 @@ public:
   bool IsLeftBehind(const double center[3], double radius, const double motion[3]) override;
   VTK_WRAPEXCLUDE bool EvaluateTranslatedDistances(
     const double motion[3], double step, const float* x, const float* y, const float* z, int count, float* distances) override;
+  VTK_WRAPEXCLUDE bool BoundTranslatedDistances(const double motion[3], double step, const double origin[3], const double stride[3],
+    const double edges[2][3], int count, double* bounds) override;
 
 protected:
   vtkVolumeCutCylinderTool() = default;

@@ -64,10 +64,10 @@ struct vtkVolumeCutField::Brick
   explicit Brick(vtkIdType id)
     : Id(id)
   {
-    for (auto& value : this->Values)
-    {
-      value.store(Outside, std::memory_order_relaxed);
-    }
+    // Plain stores, which vectorise: no reader sees the brick before the
+    // directory publishes it (release).
+    int16_t* values = reinterpret_cast<int16_t*>(this->Values);
+    std::fill(values, values + SamplesPerBrick, Outside);
   }
   const vtkIdType Id;
   // Seqlock: odd while the writer changes the values.
@@ -83,6 +83,9 @@ struct vtkVolumeCutField::Brick
   /// The writer's own record that every sample is Inside: no cut can change
   /// the brick then (Inside is the least value), so strokes skip it.
   bool AllInside = false;
+  /// The writer's own record of the stroke (StrokeSerial) whose undo step
+  /// holds the brick as it was: a stroke's later changes need no look-up.
+  vtkTypeUInt64 RememberedInStroke = 0;
   void UpdateAllInside()
   {
     const int16_t* values = this->WriterView();
@@ -498,6 +501,10 @@ vtkVolumeCutField::Brick* vtkVolumeCutField::GetOrCreateBrick(vtkIdType brickId)
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick)
 {
+  if (brick && brick->RememberedInStroke == this->StrokeSerial)
+  {
+    return;
+  }
   // A brick that did not exist is remembered empty (all Outside): a moving
   // burr enters new bricks every few segments, and the haptic thread should
   // not fill kilobytes of Outside for each.
@@ -882,13 +889,32 @@ void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16
   {
     brick = this->GetOrCreateBrick(brickId);
   }
+  brick->RememberedInStroke = this->StrokeSerial;
   // Seqlock write: readers that overlap it see an odd or changed sequence and retry.
   const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
   brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
   std::atomic_thread_fence(std::memory_order_release);
   for (int r = 0; r < runCount; ++r)
   {
-    for (int n = runs[r].Start; n < runs[r].Start + runs[r].Count; ++n)
+    // A whole row at a time, written out: atomic stores do not vectorise,
+    // and compilers do not unroll a loop of them by themselves.
+    static_assert(BrickSize == 8, "a row is eight samples");
+    int n = runs[r].Start;
+    const int end = n + runs[r].Count;
+    for (; n + BrickSize <= end; n += BrickSize)
+    {
+      std::atomic<int16_t>* row = brick->Values + n;
+      const int16_t* values = merged + n;
+      row[0].store(values[0], std::memory_order_relaxed);
+      row[1].store(values[1], std::memory_order_relaxed);
+      row[2].store(values[2], std::memory_order_relaxed);
+      row[3].store(values[3], std::memory_order_relaxed);
+      row[4].store(values[4], std::memory_order_relaxed);
+      row[5].store(values[5], std::memory_order_relaxed);
+      row[6].store(values[6], std::memory_order_relaxed);
+      row[7].store(values[7], std::memory_order_relaxed);
+    }
+    for (; n < end; ++n)
     {
       brick->Values[n].store(merged[n], std::memory_order_relaxed);
     }
@@ -899,7 +925,15 @@ void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16
   brick->Stamp.store(stamp, std::memory_order_release);
   this->StampCounter.store(stamp, std::memory_order_release);
   brick->Sequence.store(sequence + 2, std::memory_order_release);
-  brick->UpdateAllInside();
+  // A changed sample left short of Inside settles it without a scan.
+  if (merged[runs[0].Start] != Inside)
+  {
+    brick->AllInside = false;
+  }
+  else
+  {
+    brick->UpdateAllInside();
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -990,6 +1024,52 @@ bool vtkVolumeCutField::ApplyRowwise(const RowDistanceSource& source, Operation 
 }
 
 //------------------------------------------------------------------------------
+bool vtkVolumeCutField::TrimSlices(const BrickDistanceSource& source, const double origin[3], const Brick* brick,
+  const vtkVolumeCutProtection::Brick* protection, Operation operation, int& firstSlice, int& lastSlice) const
+{
+  double bounds[BrickSize];
+  if (!source.BoundSlices(origin, this->BrickSampleOffsets.data(), bounds))
+  {
+    return true;
+  }
+  // A slice cannot change where its distances (in single precision: 1e-3 mm
+  // of margin, as for the bricks) lie beyond the band, clamped to the
+  // extreme that changes nothing. A cut moreover keeps the least value: no
+  // sample changes where they round to no less than the most the field
+  // holds in the slice. Not so with protection, whose contacts are measured
+  // at every sample inside the tool.
+  const bool againstField = operation == Operation::Cut && !protection;
+  auto unchanged = [&](int slice)
+  {
+    double limit = this->BandWidth + 1e-3;
+    if (bounds[slice] > limit)
+    {
+      return true;
+    }
+    if (againstField && brick)
+    {
+      const int16_t* values = brick->WriterView() + slice * BrickSize * BrickSize;
+      int16_t highest = Inside;
+      for (int n = 0; n < BrickSize * BrickSize; ++n)
+      {
+        highest = values[n] > highest ? values[n] : highest;
+      }
+      limit = std::min(limit, (highest + 1.0) * this->Quantum + 1e-3);
+    }
+    return bounds[slice] > limit;
+  };
+  while (firstSlice <= lastSlice && unchanged(firstSlice))
+  {
+    ++firstSlice;
+  }
+  while (lastSlice >= firstSlice && unchanged(lastSlice))
+  {
+    --lastSlice;
+  }
+  return firstSlice <= lastSlice;
+}
+
+//------------------------------------------------------------------------------
 bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operation operation, const int lower[3], const int upper[3])
 {
   // Whole bricks in one uniform loop each: near a small tool the rows are a
@@ -1027,21 +1107,29 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
         }
         double origin[3];
         Transform(this->SubIJKToRAS, firstSample, origin);
-        source.BrickDistances(origin, center, this->BrickBoundingRadius, this->BrickSampleOffsets.data(), distances);
-        this->QuantizeDistances(distances, SamplesPerBrick, operation, quantized);
+        const vtkVolumeCutProtection::Brick* protection = this->GetProtectionBrick(brickId);
+        int firstSlice = 0;
+        int lastSlice = BrickSize - 1;
+        if (!this->TrimSlices(source, origin, brick, protection, operation, firstSlice, lastSlice))
+        {
+          continue;
+        }
+        source.BrickDistances(origin, center, this->BrickBoundingRadius, this->BrickSampleOffsets.data(), firstSlice, lastSlice, distances);
+        const int begin = firstSlice * BrickSize * BrickSize;
+        const int count = (lastSlice - firstSlice + 1) * BrickSize * BrickSize;
+        this->QuantizeDistances(distances + begin, count, operation, quantized + begin);
 
         // Samples past the volume's far faces exist in the brick, not in the field.
         const int valid[3] = { std::min(BrickSize, this->Dimensions[0] - bi * BrickSize), std::min(BrickSize, this->Dimensions[1] - bj * BrickSize),
           std::min(BrickSize, this->Dimensions[2] - bk * BrickSize) };
-        const vtkVolumeCutProtection::Brick* protection = this->GetProtectionBrick(brickId);
         const bool whole = valid[0] == BrickSize && valid[1] == BrickSize && valid[2] == BrickSize;
-        if (whole && !this->MergeSegment(brick, protection, brickIndex, quantized, 0, SamplesPerBrick, operation, source, merged))
+        if (whole && !this->MergeSegment(brick, protection, brickIndex, quantized + begin, begin, count, operation, source, merged + begin))
         {
           continue;
         }
         // Rows that changed: the seqlock write stores only those.
         int runCount = 0;
-        for (int k = 0; k < valid[2]; ++k)
+        for (int k = firstSlice; k <= std::min(lastSlice, valid[2] - 1); ++k)
         {
           for (int j = 0; j < valid[1]; ++j)
           {
@@ -1059,7 +1147,11 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
             {
               changed = this->MergeSegment(brick, protection, brickIndex, quantized + rowStart, rowStart, valid[0], operation, source, merged + rowStart);
             }
-            if (changed)
+            if (changed && runCount > 0 && runs[runCount - 1].Start + runs[runCount - 1].Count == rowStart)
+            {
+              runs[runCount - 1].Count += valid[0]; // one run over adjacent rows
+            }
+            else if (changed)
             {
               runs[runCount++] = { rowStart, valid[0] };
             }
@@ -1084,6 +1176,7 @@ void vtkVolumeCutField::BeginStroke()
     return;
   }
   this->StrokeOpen = true;
+  ++this->StrokeSerial;
   this->StrokeBefore.clear();
   this->StrokeBeforeMemory = 0;
 }

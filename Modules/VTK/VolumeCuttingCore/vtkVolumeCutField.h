@@ -436,6 +436,10 @@ protected:
   void ApplyWithinStroke(const DistanceSource& source, Writer&& write);
   bool ApplyRowwise(const RowDistanceSource& source, Operation operation, const int lower[3], const int upper[3]);
   bool ApplyBrickwise(const BrickDistanceSource& source, Operation operation, const int lower[3], const int upper[3]);
+  /// Narrows a brick's z-slices firstSlice..lastSlice to those the source's
+  /// bounds say may change; false when none may.
+  bool TrimSlices(const BrickDistanceSource& source, const double origin[3], const Brick* brick, const vtkVolumeCutProtection::Brick* protection,
+    Operation operation, int& firstSlice, int& lastSlice) const;
   void QuantizeDistances(const float* distances, int count, Operation operation, int16_t* quantized) const;
   /// Merges a run of quantised tool distances into a brick (null: not
   /// allocated) at sample rowStart; records contacts with protected samples.
@@ -541,6 +545,8 @@ protected:
   // Bricks touched by the open stroke: their values before it began.
   BrickStates StrokeBefore;
   size_t StrokeBeforeMemory = 0;
+  /// Counts the strokes begun: a brick remembered in this one carries its number.
+  vtkTypeUInt64 StrokeSerial = 0;
   std::atomic<vtkTypeUInt64> StampCounter{ 0 };
   std::vector<UndoStep> UndoStack;
   std::vector<UndoStep> RedoStack;

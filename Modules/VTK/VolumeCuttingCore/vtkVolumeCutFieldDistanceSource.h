@@ -39,7 +39,18 @@ struct vtkVolumeCutField::BrickDistanceSource : vtkVolumeCutField::DistanceSourc
   virtual bool MayReach(const double center[3], double radius) const = 0;
   /// Distances at origin + offsets, the field's brick sample offsets (x, y
   /// and z runs of BrickSize^3 each); the samples lie within radius of center.
-  virtual void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const = 0;
+  /// Only those of the z-slices firstSlice..lastSlice (BrickSize^2 samples
+  /// of one k each, contiguous) are read; a source may leave others unwritten.
+  virtual void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, int firstSlice,
+    int lastSlice, float* distances) const = 0;
+  /// Lower bounds (mm) of BrickDistances over each z-slice of the brick, or
+  /// false (the default) when the source cannot tell. The writer skips the
+  /// slices whose bound is beyond the band, or above every value the field
+  /// holds there: their distances would change nothing.
+  virtual bool BoundSlices(const double /*origin*/[3], const float* /*offsets*/, double /*bounds*/[vtkVolumeCutField::BrickSize]) const
+  {
+    return false;
+  }
 };
 
 #endif

@@ -37,9 +37,11 @@ struct Table
   /// with (w . ab) / |ab|^2 below behindLimit are given far instead.
   void (*CapsuleBrickDistances)(const float w0[3], const float ab[3], float inverseLength2, float radius, float behindLimit, float far,
     const float* offsets, float* distances);
-  /// A brick's samples (w0 + offsets) rotated into a tool's frame (rotation
-  /// is tool-to-RAS): x, y and z runs.
-  void (*ToToolFrame)(const float rotation[3][3], const float w0[3], const float* offsets, float* x, float* y, float* z);
+  /// count of a brick's samples (w0 + offsets; offsets points into the x
+  /// run of the brick's offsets, the y and z runs SamplesPerBrick and twice
+  /// that further) rotated into a tool's frame (rotation is tool-to-RAS):
+  /// x, y and z runs.
+  void (*ToToolFrame)(const float rotation[3][3], const float w0[3], const float* offsets, int count, float* x, float* y, float* z);
   /// distances = min(distances, copy) where the sample is within reach of
   /// the copy's centre (farther, a tool's distance may underestimate).
   void (*MergeCopy)(const float* x, const float* y, const float* z, const float* copy, float reach2, float* distances);
@@ -56,6 +58,9 @@ struct Table
   /// cross-section): the disk of radius about offset (x, y) moved along
   /// segment (x, y), times the slab offset[2] +- halfLength.
   void (*CylinderSweptMinimum)(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+    const float* x, const float* y, const float* z, int count, float* distances);
+  /// The same distances stored, not merged: the first piece of a sweep.
+  void (*CylinderSwept)(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
     const float* x, const float* y, const float* z, int count, float* distances);
 };
 

@@ -41,15 +41,15 @@ void CapsuleBrickDistances(const float w0[3], const float ab[3], float inverseLe
   }
 }
 
-void ToToolFrame(const float rotation[3][3], const float w0[3], const float* __restrict offsets, float* __restrict x, float* __restrict y,
-  float* __restrict z)
+void ToToolFrame(const float rotation[3][3], const float w0[3], const float* __restrict offsets, int count, float* __restrict x,
+  float* __restrict y, float* __restrict z)
 {
   // Locals: the stores below cannot then be taken to change them.
   const float r00 = rotation[0][0], r01 = rotation[0][1], r02 = rotation[0][2];
   const float r10 = rotation[1][0], r11 = rotation[1][1], r12 = rotation[1][2];
   const float r20 = rotation[2][0], r21 = rotation[2][1], r22 = rotation[2][2];
   const float w0x = w0[0], w0y = w0[1], w0z = w0[2];
-  for (int n = 0; n < SamplesPerBrick; ++n)
+  for (int n = 0; n < count; ++n)
   {
     const float wx = w0x + offsets[n];
     const float wy = w0y + offsets[SamplesPerBrick + n];
@@ -142,7 +142,8 @@ void BoxDistances(const float half[3], const float* x, const float* y, const flo
     distances[n] = sqrtf(ox * ox + oy * oy + oz * oz) + (largest < 0.0f ? largest : 0.0f);
   }
 }
-void CylinderSweptMinimum(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+template <bool Minimum>
+void CylinderSweptRun(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
   const float* x, const float* y, const float* z, int count, float* __restrict distances)
 {
   const float ox = offset[0], oy = offset[1], oz = offset[2];
@@ -164,10 +165,29 @@ void CylinderSweptMinimum(float radius, float halfLength, const float offset[3],
     const float outsideAxial = axial > 0.0f ? axial : 0.0f;
     const float larger = radial > axial ? radial : axial;
     const float distance = sqrtf(outsideRadial * outsideRadial + outsideAxial * outsideAxial) + (larger < 0.0f ? larger : 0.0f);
-    distances[n] = distance < distances[n] ? distance : distances[n];
+    if (Minimum)
+    {
+      distances[n] = distance < distances[n] ? distance : distances[n];
+    }
+    else
+    {
+      distances[n] = distance;
+    }
   }
+}
+
+void CylinderSweptMinimum(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2,
+  const float* x, const float* y, const float* z, int count, float* distances)
+{
+  CylinderSweptRun<true>(radius, halfLength, offset, segment, inverseSegmentLength2, x, y, z, count, distances);
+}
+
+void CylinderSwept(float radius, float halfLength, const float offset[3], const float segment[2], float inverseSegmentLength2, const float* x,
+  const float* y, const float* z, int count, float* distances)
+{
+  CylinderSweptRun<false>(radius, halfLength, offset, segment, inverseSegmentLength2, x, y, z, count, distances);
 }
 } // namespace
 
 const vtkVolumeCutKernels::Table vtkVolumeCutKernels::VOLUMECUTTING_KERNELS_TABLE = { CapsuleBrickDistances, ToToolFrame, MergeCopy, QuantizeRun,
-  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances, CylinderSweptMinimum };
+  MinimumRun, CylinderDistances, EllipsoidDistances, BoxDistances, CylinderSweptMinimum, CylinderSwept };

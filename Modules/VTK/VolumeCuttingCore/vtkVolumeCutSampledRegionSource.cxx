@@ -212,7 +212,7 @@ bool SampledRegionSource::MayReach(const double center[3], double radius) const
 }
 
 //------------------------------------------------------------------------------
-void SampledRegionSource::BrickDistances(const double origin[3], const double*, double, const float* offsets, float* distances) const
+void SampledRegionSource::BrickDistances(const double origin[3], const double*, double, const float* offsets, int, int, float* distances) const
 {
   for (int n = 0; n < SamplesPerBrick; ++n)
   {

@@ -40,7 +40,8 @@ public:
   void GetReachBounds(double lower[3], double upper[3]) const override;
   double Distance(const double point[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
-  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override;
+  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, int firstSlice, int lastSlice,
+    float* distances) const override;
 
 private:
   /// Maximum over the components, interpolated at anatomy index (i, j, k).

@@ -15,10 +15,13 @@ namespace vtkVolumeCutSweeps
 {
 namespace
 {
-constexpr int SamplesPerBrick = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
+constexpr int BrickSize = vtkVolumeCutField::BrickSize;
+constexpr int SamplesPerSlice = BrickSize * BrickSize;
+constexpr int SamplesPerBrick = BrickSize * SamplesPerSlice;
 
-/// A brick's samples (origin + offsets) in the frame of the tool at pose.
-void ToToolFrame(const RigidPose& pose, const double origin[3], const float* offsets, float local[3][SamplesPerBrick])
+/// A brick's samples (origin + offsets) from first on, count of them, in the
+/// frame of the tool at pose.
+void ToToolFrame(const RigidPose& pose, const double origin[3], const float* offsets, int first, int count, float local[3][SamplesPerBrick])
 {
   float rotation[3][3];
   for (int row = 0; row < 3; ++row)
@@ -30,7 +33,7 @@ void ToToolFrame(const RigidPose& pose, const double origin[3], const float* off
   }
   const float w0[3] = { static_cast<float>(origin[0] - pose.Translation[0]), static_cast<float>(origin[1] - pose.Translation[1]),
     static_cast<float>(origin[2] - pose.Translation[2]) };
-  vtkVolumeCutKernels::Get().ToToolFrame(rotation, w0, offsets, local[0], local[1], local[2]);
+  vtkVolumeCutKernels::Get().ToToolFrame(rotation, w0, offsets + first, count, local[0] + first, local[1] + first, local[2] + first);
 }
 } // namespace
 
@@ -184,7 +187,8 @@ bool CapsuleSource::MayReach(const double center[3], double radius) const
 }
 
 //------------------------------------------------------------------------------
-void CapsuleSource::BrickDistances(const double origin[3], const double* /*center*/, double /*radius*/, const float* offsets, float* distances) const
+void CapsuleSource::BrickDistances(
+  const double origin[3], const double* /*center*/, double /*radius*/, const float* offsets, int, int, float* distances) const
 {
   const float w0[3] = { static_cast<float>(origin[0] - this->P0[0]), static_cast<float>(origin[1] - this->P0[1]),
     static_cast<float>(origin[2] - this->P0[2]) };
@@ -312,15 +316,46 @@ bool SweptToolSource::MayReach(const double center[3], double radius) const
 }
 
 //------------------------------------------------------------------------------
-void SweptToolSource::BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const
+bool SweptToolSource::BoundSlices(const double origin[3], const float* offsets, double bounds[BrickSize]) const
+{
+  if (!this->ClosedForm)
+  {
+    return false;
+  }
+  // The brick's slices in the first copy's frame, as the samples lie.
+  const RigidPose& first = this->Poses.front();
+  double base[3];
+  double stride[3];
+  double edges[2][3];
+  for (int row = 0; row < 3; ++row)
+  {
+    base[row] = stride[row] = edges[0][row] = edges[1][row] = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const float* run = offsets + axis * SamplesPerBrick;
+      const double r = first.Rotation[axis][row];
+      base[row] += r * (origin[axis] + run[0] - first.Translation[axis]);
+      stride[row] += r * (static_cast<double>(run[SamplesPerSlice]) - run[0]);
+      edges[0][row] += r * (static_cast<double>(run[BrickSize - 1]) - run[0]);
+      edges[1][row] += r * (static_cast<double>(run[SamplesPerSlice - BrickSize]) - run[0]);
+    }
+  }
+  return this->Tool->BoundTranslatedDistances(this->Motion, this->Step, base, stride, edges, BrickSize, bounds);
+}
+
+//------------------------------------------------------------------------------
+void SweptToolSource::BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, int firstSlice,
+  int lastSlice, float* distances) const
 {
   // Beyond the band: clamped to Outside, so a copy out of reach changes nothing.
   float local[3][SamplesPerBrick];
   if (this->ClosedForm)
   {
-    // One evaluation of the whole translated sweep.
-    ToToolFrame(this->Poses.front(), origin, offsets, local);
-    this->Tool->EvaluateTranslatedDistances(this->Motion, this->Step, local[0], local[1], local[2], SamplesPerBrick, distances);
+    // One evaluation of the whole translated sweep, over the slices asked for.
+    const int begin = firstSlice * SamplesPerSlice;
+    const int count = (lastSlice - firstSlice + 1) * SamplesPerSlice;
+    ToToolFrame(this->Poses.front(), origin, offsets, begin, count, local);
+    this->Tool->EvaluateTranslatedDistances(this->Motion, this->Step, local[0] + begin, local[1] + begin, local[2] + begin, count, distances + begin);
     return;
   }
   const float far = static_cast<float>(this->Reach);
@@ -333,7 +368,7 @@ void SweptToolSource::BrickDistances(const double origin[3], const double center
     {
       continue;
     }
-    ToToolFrame(this->Poses[n], origin, offsets, local);
+    ToToolFrame(this->Poses[n], origin, offsets, 0, SamplesPerBrick, local);
     this->Tool->EvaluateDistances(local[0], local[1], local[2], SamplesPerBrick, copy);
     vtkVolumeCutKernels::Get().MergeCopy(local[0], local[1], local[2], copy, static_cast<float>(this->Reach * this->Reach), distances);
   }

@@ -47,7 +47,8 @@ public:
   void GetReachBounds(double lower[3], double upper[3]) const override;
   double Distance(const double point[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
-  void BrickDistances(const double origin[3], const double* center, double radius, const float* offsets, float* distances) const override;
+  void BrickDistances(const double origin[3], const double* center, double radius, const float* offsets, int firstSlice, int lastSlice,
+    float* distances) const override;
 
 private:
   double P0[3];
@@ -80,7 +81,11 @@ public:
   SweptToolSource(vtkVolumeCutTool* tool, std::vector<RigidPose> poses, double band, double step, bool startCovered, const double* motion);
   void GetReachBounds(double lower[3], double upper[3]) const override;
   bool MayReach(const double center[3], double radius) const override;
-  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, float* distances) const override;
+  void BrickDistances(const double origin[3], const double center[3], double radius, const float* offsets, int firstSlice, int lastSlice,
+    float* distances) const override;
+  /// The tool's own bounds (vtkVolumeCutTool::BoundTranslatedDistances) for
+  /// a translation with a closed form.
+  bool BoundSlices(const double origin[3], const float* offsets, double bounds[vtkVolumeCutField::BrickSize]) const override;
   double Distance(const double point[3]) const override;
 
 private:

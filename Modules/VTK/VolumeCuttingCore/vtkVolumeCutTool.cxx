@@ -38,3 +38,9 @@ bool vtkVolumeCutTool::EvaluateTranslatedDistances(const double*, double, const 
 {
   return false;
 }
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutTool::BoundTranslatedDistances(const double*, double, const double*, const double*, const double[2][3], int, double*)
+{
+  return false;
+}

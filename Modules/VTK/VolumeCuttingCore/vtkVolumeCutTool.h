@@ -70,6 +70,20 @@ public:
   VTK_WRAPEXCLUDE virtual bool EvaluateTranslatedDistances(
     const double motion[3], double step, const float* x, const float* y, const float* z, int count, float* distances);
 
+  /**
+   * Lower bounds (mm) of EvaluateTranslatedDistances (same motion and step)
+   * over count parallel flat slices (tool frame): slice s holds the points
+   * origin + s * stride + u * edges[0] + v * edges[1], u and v in [0, 1].
+   * The cut field's writer evaluates only the slices of a brick (its
+   * z-slices) whose bound is within its band, so a flat tool (a disk saw)
+   * pays for the few it crosses, not for whole bricks. A tool bounding the
+   * radial and axial terms of its distance separately gets far tighter
+   * bounds than one sphere about the brick. Returns false, writing nothing,
+   * when not known (the default): every slice is then evaluated.
+   */
+  VTK_WRAPEXCLUDE virtual bool BoundTranslatedDistances(const double motion[3], double step, const double origin[3], const double stride[3],
+    const double edges[2][3], int count, double* bounds);
+
   /// Whether the tool can cut: finite, positive sizes (and a closed surface for
   /// meshes). Logs an error saying what is wrong otherwise.
   virtual bool IsValid() = 0;
