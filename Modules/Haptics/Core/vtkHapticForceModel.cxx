@@ -317,7 +317,7 @@ bool vtkHapticForceModel::IsSolid(const double ras[3]) const
 }
 
 //------------------------------------------------------------------------------
-void vtkHapticForceModel::Measure(const double ras[3], Margins& margins) const
+void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool withCut) const
 {
   const Internals& internal = *this->Internal;
   margins.Anatomy = -1.0;
@@ -337,7 +337,7 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins) const
   margins.InBox = true;
   margins.Anatomy = internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) - this->SurfaceIsoValue;
   // The cut field costs several times the CT's lookup: only where the CT is solid.
-  if (this->CutField && !(margins.Anatomy < 0.0))
+  if (withCut && this->CutField && !(margins.Anatomy < 0.0))
   {
     margins.Removal = this->CutField->GetSignedDistance(ras);
   }
@@ -413,30 +413,34 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
   // 1/256 of a step (a step is half a voxel): far inside the 0.1 voxel the
   // force must agree with the picture.
   const double tolerance = step / 256.0;
+  auto at = [p, u](double s, double point[3]) {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      point[axis] = p[axis] + s * u[axis];
+    }
+  };
+  // The cut field is a distance (mm) and changes by no more than about a
+  // millimetre per millimetre along the trace (0.9 leaves room for its
+  // interpolation): closer than 0.9 of its value at p, no cut ends the
+  // material and only the CT is sampled. Just beyond its value is where a
+  // trace facing the cut surface leaves (as in the burr's own cavity): the
+  // first sample there brackets that border with one lookup.
+  const bool cut = this->CutField != nullptr;
+  const double cutFree = cut ? 0.9 * atStart.Removal : VTK_DOUBLE_MAX;
+  const double guess = cut ? std::max(1.05 * atStart.Removal + tolerance, tolerance) : VTK_DOUBLE_MAX;
   double inside = 0.0;
-  Margins last = atStart;
-  // The cut field is a distance (mm): where it is nearer than a step, the
-  // trace most likely leaves there (exactly so for a cut surface facing the
-  // trace, as in the burr's own cavity), so the first sample is taken just
-  // beyond it and brackets the border with one lookup.
-  double first = step;
-  if (atStart.Removal < step)
+  double insideAnatomy = atStart.Anatomy;
+  // The last solid sample where the cut field was measured.
+  double measured = 0.0;
+  double measuredRemoval = atStart.Removal;
+  for (double t = std::min({ step, guess, length });;)
   {
-    first = std::max(1.05 * atStart.Removal + tolerance, tolerance);
-  }
-  for (double t = std::min(first, length);; t = std::min(t + step, length))
-  {
-    const double q[3] = { p[0] + t * u[0], p[1] + t * u[1], p[2] + t * u[2] };
+    double q[3];
+    at(t, q);
     Margins here;
-    this->Measure(q, here);
+    this->Measure(q, here, t >= cutFree);
     if (!here.IsSolid())
     {
-      auto at = [p, u](double s, double point[3]) {
-        for (int axis = 0; axis < 3; ++axis)
-        {
-          point[axis] = p[axis] + s * u[axis];
-        }
-      };
       if (!here.InBox)
       {
         // Left the volume's box (convex, so between the two samples only
@@ -451,17 +455,17 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         }
         return 0.5 * (inside + outside);
       }
-      double exit = t;
+      double end = t;
       if (here.Anatomy < 0.0)
       {
-        exit = FindBorder(
+        const double exit = FindBorder(
           [&](double s) {
             double m[3];
             at(s, m);
             return this->AnatomyMargin(m);
           },
-          inside, last.Anatomy, t, here.Anatomy, tolerance);
-        if (!this->CutField)
+          inside, insideAnatomy, t, here.Anatomy, tolerance);
+        if (exit - tolerance < cutFree)
         {
           return exit;
         }
@@ -473,11 +477,11 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         {
           return exit;
         }
-        t = exit - tolerance;
+        end = exit - tolerance;
       }
-      if (!(t > inside))
+      if (!(end > measured))
       {
-        return inside;
+        return measured;
       }
       return FindBorder(
         [&](double s) {
@@ -485,14 +489,22 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
           at(s, m);
           return this->CutField->GetSignedDistance(m);
         },
-        inside, last.Removal, t, here.Removal, tolerance);
+        measured, measuredRemoval, end, here.Removal, tolerance);
     }
     inside = t;
-    last = here;
+    insideAnatomy = here.Anatomy;
+    if (t >= cutFree)
+    {
+      measured = t;
+      measuredRemoval = here.Removal;
+    }
     if (t >= length)
     {
       return length;
     }
+    // A step on, stopping at the guess on the way.
+    const double next = t < guess ? std::min(t + step, guess) : t + step;
+    t = std::min(next, length);
   }
 }
 

@@ -308,7 +308,8 @@ protected:
     bool InBox;      ///< inside the CT's box
     bool IsSolid() const { return this->InBox && !(this->Anatomy < 0.0) && !(this->Removal < 0.0); }
   };
-  void Measure(const double ras[3], Margins& margins) const;
+  /// withCut false leaves the cut field out (Removal stays the largest double).
+  void Measure(const double ras[3], Margins& margins, bool withCut = true) const;
   /// The CT less the iso-value at a point known to be inside the CT's box.
   double AnatomyMargin(const double ras[3]) const;
   /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length.
