@@ -540,12 +540,15 @@ void vtkHapticLoop::Run()
     }
     previousStart = start;
     hasPrevious = true;
+    // The processor time is read inside the wall-clock interval, so that a
+    // tick's processor time never exceeds its wall time.
     const double processorStart = ThreadProcessorMicroseconds();
     this->Tick(timeStep);
+    const double processorEnd = ThreadProcessorMicroseconds();
     const Clock::time_point end = Clock::now();
     const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
     internal.Durations[timed % capacity] = std::chrono::duration<float, std::micro>(end - start).count();
-    internal.ProcessorDurations[timed % capacity] = static_cast<float>(ThreadProcessorMicroseconds() - processorStart);
+    internal.ProcessorDurations[timed % capacity] = static_cast<float>(processorEnd - processorStart);
     internal.Timed.store(timed + 1, std::memory_order_release);
     deadline += period;
     if (end > deadline)
