@@ -82,8 +82,8 @@ struct vtkVolumeCutVolumeMapper::Internals
   // The same for the last reduced frame, 0 before the first. A reduced ray
   // costs more than a full frame's (no ambient occlusion, but the frame's
   // fixed work spread over a few thousand rays, not 800 000): the first
-  // moving frame after a still one, chosen from the full frame's cost, was
-  // the slowest of a motion.
+  // moving frame after a still one, sized from the full frame's cost, got a
+  // finer grid than the frames after it.
   double DraftSecondsPerRay = 0.0;
   // What the window's frame costs besides this mapper (clearing, other
   // props, compositing and swapping): an interactive frame leaves it its
