@@ -45,17 +45,18 @@ public:
     vtkMath::Cross(normal, tangent, bitangent);
     double origin[3];
     this->Classifier.WorldPoint(index, origin);
-    const double cosine = std::cos(vtkMath::RadiansFromDegrees(55.0));
-    const double sine = std::sin(vtkMath::RadiansFromDegrees(55.0));
+    // The fixed directions' sines and cosines, once: the same values as
+    // computed for each point before, so the image does not change.
+    static const Directions directions;
     int occupied = 0;
     for (int direction = 0; direction < 7; ++direction)
     {
       double d[3];
-      const double angle = vtkMath::Pi() / 3.0 * direction;
       for (int axis = 0; axis < 3; ++axis)
       {
         d[axis] = direction == 0 ? normal[axis]
-                                 : cosine * normal[axis] + sine * (std::cos(angle) * tangent[axis] + std::sin(angle) * bitangent[axis]);
+                                 : directions.Cosine * normal[axis] +
+            directions.Sine * (directions.AroundCosine[direction] * tangent[axis] + directions.AroundSine[direction] * bitangent[axis]);
       }
       for (double reach : { 0.35, 1.0 })
       {
@@ -71,7 +72,10 @@ public:
         {
           inside &= s.Index[axis] >= 0.0 && s.Index[axis] <= this->Scene.Dimensions[axis] - 1;
         }
-        if (inside)
+        // A point in a cell where no object can be is not in visible
+        // material: counted without classifying it (most points over a
+        // surface lie in air or soft tissue).
+        if (inside && this->Scene.EmptySpace.MayHoldObject(s.Index))
         {
           this->Classifier.EvaluateObject(s);
           occupied += this->Classifier.Visible(s) ? 1 : 0;
@@ -92,6 +96,23 @@ public:
   }
 
 private:
+  struct Directions
+  {
+    double Cosine = std::cos(vtkMath::RadiansFromDegrees(55.0));
+    double Sine = std::sin(vtkMath::RadiansFromDegrees(55.0));
+    double AroundCosine[7];
+    double AroundSine[7];
+    Directions()
+    {
+      for (int direction = 0; direction < 7; ++direction)
+      {
+        const double angle = vtkMath::Pi() / 3.0 * direction;
+        this->AroundCosine[direction] = std::cos(angle);
+        this->AroundSine[direction] = std::sin(angle);
+      }
+    }
+  };
+
   const vtkVolumeCutRayScene& Scene;
   const vtkVolumeCutSampleClassifier& Classifier;
 };

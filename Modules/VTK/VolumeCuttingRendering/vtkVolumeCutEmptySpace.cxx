@@ -195,9 +195,18 @@ void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int m
       for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
       {
         const float from = visibleFrom(fraction.Label);
+        // A segment drawn by its shape shows where its fraction, its weight
+        // there, is at least a half: a cell whose corners all stay under
+        // that cannot hold it (the trilinear fraction is at most the
+        // largest corner's; the margin covers rounding). Smoothed fractions
+        // are above 0 far around their segment, where every sample would
+        // otherwise weigh the labels.
+        const bool shape = from == Always;
+        constexpr float Half = 0.5f * (1.f - 1e-5f);
         for (vtkIdType v = 0; v < sliceSize; ++v)
         {
-          if (fraction.Values[offset + v] > 0.f)
+          const float value = fraction.Values[offset + v];
+          if (shape ? value >= Half : value > 0.f)
           {
             needed[v] = std::min(needed[v], from);
           }

@@ -116,6 +116,25 @@ public:
     return entry;
   }
 
+  /**
+   * Whether the cell holding p (IJK, inside the volume) may hold a visible
+   * object: where it may not, no sample there is in an object, which lets
+   * ambient occlusion count such a point without classifying it.
+   */
+  bool MayHoldObject(const double p[3]) const
+  {
+    if (this->CellBits.empty())
+    {
+      return true;
+    }
+    int cell[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      cell[axis] = std::min(std::max(static_cast<int>(std::floor(p[axis])), 0), this->CellDimensions[axis] - 1);
+    }
+    return this->CellMayHoldObject(cell);
+  }
+
   const int* GetDimensions() const { return this->Dimensions; }
   const uint8_t* GetOccupied() const { return this->Occupied.data(); }
   const float* GetGradientBounds() const { return this->GradientBound.data(); }

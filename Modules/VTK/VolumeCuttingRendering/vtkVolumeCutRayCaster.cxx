@@ -786,10 +786,12 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   }
 
   impl.Scene.AnyIsoSegment = false;
+  impl.Scene.AnyShapeSegment = false;
   impl.Scene.MinimumIso = std::numeric_limits<double>::infinity();
   for (size_t label = 1; label < impl.Scene.Styles.size(); ++label)
   {
     const SegmentStyle& style = impl.Scene.Styles[label];
+    impl.Scene.AnyShapeSegment |= style.Opacity > 0.f && style.Shape;
     if (style.Opacity > 0.f && !style.Shape && (label == 1 || impl.Scene.HasSegments()))
     {
       impl.Scene.AnyIsoSegment = true;

@@ -66,6 +66,9 @@ struct vtkVolumeCutRayScene
   /// A visible segment is drawn at a CT iso-value (not by its own shape), and the lowest such value.
   bool AnyIsoSegment = false;
   double MinimumIso = 0.0;
+  /// A visible segment is drawn by its own shape (its indicator at 0.5),
+  /// whatever the CT value.
+  bool AnyShapeSegment = false;
 
   bool HasSegments() const { return !this->Labels.empty() || !this->Fractions.empty(); }
 

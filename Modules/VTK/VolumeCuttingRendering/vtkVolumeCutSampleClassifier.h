@@ -460,6 +460,13 @@ public:
       const vtkVolumeCutRayScene::SegmentStyle& style = scene.Styles[1];
       return (style.Opacity > 0.f && value >= style.Iso) ? 1 : 0;
     }
+    if (!scene.AnyShapeSegment && !(double(value) >= scene.MinimumIso))
+    {
+      // Under every shown segment's iso-value and no segment drawn by its
+      // shape: no label can be visible here, whichever dominates (most
+      // samples in soft tissue beside bone, and most ambient occlusion's).
+      return 0;
+    }
     double weight = 0.0;
     const int label = this->DominantLabel(p, weight);
     if (label == 0 || label >= static_cast<int>(scene.Styles.size()) || scene.Styles[label].Opacity <= 0.f)

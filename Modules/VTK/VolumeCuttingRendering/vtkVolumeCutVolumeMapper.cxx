@@ -79,6 +79,12 @@ struct vtkVolumeCutVolumeMapper::Internals
   // Measured cost of a CPU frame per ray cast (drawing included), 0 before
   // the first: what an interactive frame's resolution is chosen from.
   double SecondsPerRay = 0.0;
+  // The same for the last reduced frame, 0 before the first. A reduced ray
+  // costs more than a full frame's (no ambient occlusion, but the frame's
+  // fixed work spread over a few thousand rays, not 800 000): the first
+  // moving frame after a still one, sized from the full frame's cost, got a
+  // finer grid than the frames after it.
+  double DraftSecondsPerRay = 0.0;
   // What the window's frame costs besides this mapper (clearing, other
   // props, compositing and swapping): an interactive frame leaves it its
   // share of the time the window allows.
@@ -450,7 +456,8 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   impl.MapperTimeInFrame = this->LastFrameTime;
   if (path == CPUPath && caster->GetNumberOfRaysCast() > 0 && !caster->GetLastRenderWasLocalized())
   {
-    impl.SecondsPerRay = this->LastFrameTime / static_cast<double>(caster->GetNumberOfRaysCast());
+    (sampleDistance > 1 ? impl.DraftSecondsPerRay : impl.SecondsPerRay) =
+      this->LastFrameTime / static_cast<double>(caster->GetNumberOfRaysCast());
   }
 }
 
@@ -470,7 +477,8 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
   {
     return 1;
   }
-  if (this->Impl->SecondsPerRay <= 0.0)
+  const double secondsPerRay = this->Impl->DraftSecondsPerRay > 0.0 ? this->Impl->DraftSecondsPerRay : this->Impl->SecondsPerRay;
+  if (secondsPerRay <= 0.0)
   {
     // No frame measured yet: the coarsest, so that the first motion responds.
     return this->MaximumImageSampleDistance;
@@ -481,7 +489,7 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
   const double allowed = std::max(0.2 / rate, 1.0 / rate - this->Impl->RestOfFrame);
   // Rays cost about the same each, so the distance goes with the square root
   // of the full frame's time over the time allowed.
-  const double fullFrame = this->Impl->SecondsPerRay * width * height;
+  const double fullFrame = secondsPerRay * width * height;
   const int distance = static_cast<int>(std::ceil(std::sqrt(fullFrame / allowed)));
   return std::max(1, std::min(this->MaximumImageSampleDistance, distance));
 }
