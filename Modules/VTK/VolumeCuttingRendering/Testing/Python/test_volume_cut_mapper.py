@@ -860,6 +860,18 @@ def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
     assert mapper.GetLastImageSampleDistance() >= 4
 
 
+def set_transfer_functions(volume, colors, opacities):
+    """The volume property's colour points (value, r, g, b) and opacity points (value, opacity per mm)."""
+    color = vtk.vtkColorTransferFunction()
+    for point in colors:
+        color.AddRGBPoint(*point)
+    opacity = vtk.vtkPiecewiseFunction()
+    for point in opacities:
+        opacity.AddPoint(*point)
+    volume.GetProperty().SetColor(color)
+    volume.GetProperty().SetScalarOpacity(opacity)
+
+
 def test_gpu_and_cpu_paths_composite_the_same_image():
     """Composite mode on the cut cube: both paths give the same emission-absorption image.
 
@@ -877,14 +889,7 @@ def test_gpu_and_cpu_paths_composite_the_same_image():
     renderer.SetActiveCamera(A.make_camera(scene, 2.0, width, width))
     mapper, volume = add_cut_volume(scene, scene.intensities(), scene.cut_field(1), renderer)
     mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
-    color = vtk.vtkColorTransferFunction()
-    color.AddRGBPoint(0.0, 1.0, 1.0, 1.0)
-    color.AddRGBPoint(1000.0, 1.0, 0.9, 0.8)
-    opacity = vtk.vtkPiecewiseFunction()
-    opacity.AddPoint(400.0, 0.0)
-    opacity.AddPoint(1000.0, 0.5)
-    volume.GetProperty().SetColor(color)
-    volume.GetProperty().SetScalarOpacity(opacity)
+    set_transfer_functions(volume, [(0.0, 1.0, 1.0, 1.0), (1000.0, 1.0, 0.9, 0.8)], [(400.0, 0.0), (1000.0, 0.5)])
     images = render_on_both_paths(window, mapper, width)
     cpu_color = images[vc.vtkVolumeCutVolumeMapper.CPUPath][1]
     gpu_color = images[vc.vtkVolumeCutVolumeMapper.GPUPath][1]
@@ -922,14 +927,7 @@ def test_composite_opacity_is_corrected_for_the_thickness_on_both_paths():
         volume = vtk.vtkVolume()
         volume.SetMapper(mapper)
         renderer.AddVolume(volume)
-        color = vtk.vtkColorTransferFunction()
-        color.AddRGBPoint(1000.0, 1.0, 1.0, 1.0)
-        color.AddRGBPoint(1150.0, 1.0, 0.0, 0.0)
-        opacity = vtk.vtkPiecewiseFunction()
-        opacity.AddPoint(1000.0, 0.5)
-        opacity.AddPoint(1150.0, 0.5)
-        volume.GetProperty().SetColor(color)
-        volume.GetProperty().SetScalarOpacity(opacity)
+        set_transfer_functions(volume, [(1000.0, 1.0, 1.0, 1.0), (1150.0, 1.0, 0.0, 0.0)], [(1000.0, 0.5), (1150.0, 0.5)])
         alpha = 1.0 - 0.5**thickness
         x = 7.5 + (np.arange(width) + 0.5 - width / 2) * 0.25
         green = 255.0 * alpha * np.clip(1.0 - 10.0 * x / 150.0, 0.0, 1.0)
