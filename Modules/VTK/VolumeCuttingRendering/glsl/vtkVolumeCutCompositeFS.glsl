@@ -72,7 +72,12 @@ bool compositeStep(inout Sample a, inout Sample b, inout int lastCutBorder)
               minus[axis] -= gradientStep;
               gradient[axis] = intensity(minus) - intensity(plus);
             }
-            normal = normalize(normalMatrix * gradient);
+            // Where the CT is uniform there is no gradient: the piece is lit by
+            // the ambient term alone, as on the CPU (normalize() of a zero
+            // vector is NaN, which the driver may turn into full white).
+            vec3 worldGradient = normalMatrix * gradient;
+            float gradientLength = length(worldGradient);
+            normal = gradientLength > 0.0 ? worldGradient / gradientLength : vec3(0.0);
           }
           record(startT, shade(tf.rgb, normal, viewVector), alpha, 0.02);
           done = accumulated.a >= 0.995;
