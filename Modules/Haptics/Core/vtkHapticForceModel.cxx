@@ -343,19 +343,6 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
   }
 }
 
-//------------------------------------------------------------------------------
-double vtkHapticForceModel::AnatomyMargin(const double ras[3]) const
-{
-  const Internals& internal = *this->Internal;
-  double ijk[3];
-  for (int row = 0; row < 3; ++row)
-  {
-    ijk[row] = internal.RASToIJK[row][0] * ras[0] + internal.RASToIJK[row][1] * ras[1] + internal.RASToIJK[row][2] * ras[2] +
-      internal.RASToIJK[row][3];
-  }
-  return internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) - this->SurfaceIsoValue;
-}
-
 namespace
 {
 /// Where margin(t) falls below zero between a (margin >= 0) and b (margin <
@@ -462,7 +449,9 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
           [&](double s) {
             double m[3];
             at(s, m);
-            return this->AnatomyMargin(m);
+            Margins margins;
+            this->Measure(m, margins, false);
+            return margins.Anatomy;
           },
           inside, insideAnatomy, t, here.Anatomy, tolerance);
         if (exit - tolerance < cutFree)

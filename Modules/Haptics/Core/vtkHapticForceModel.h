@@ -310,8 +310,6 @@ protected:
   };
   /// withCut false leaves the cut field out (Removal stays the largest double).
   void Measure(const double ras[3], Margins& margins, bool withCut = true) const;
-  /// The CT less the iso-value at a point known to be inside the CT's box.
-  double AnatomyMargin(const double ras[3]) const;
   /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length.
   double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart) const;
 
