@@ -82,6 +82,11 @@ struct vtkHapticForceModel::Internals
   double RASToIJK[3][4];
   std::vector<double> Shell;
   int ShellCount = 0;
+  /// The last contact test's push directions (unit), three values a contact, for the proxy's step.
+  std::vector<double> ContactDirections;
+  /// The last contact test's points in the cut: offset from the centre and cut-field distance, four values a point.
+  std::vector<double> Clearances;
+  int NumberOfClearances = 0;
   /// Steps of the trace toward the centre, and the longest proxy step (mm).
   double TraceStep = 0.1;
   double ProxyStep = 0.5;
@@ -260,6 +265,9 @@ bool vtkHapticForceModel::Prepare()
   }
   internal.ShellCount = this->PointShell->GetNumberOfPoints();
   internal.Shell.assign(this->PointShell->GetPointData(), this->PointShell->GetPointData() + 3 * internal.ShellCount);
+  internal.ContactDirections.assign(3 * internal.ShellCount, 0.0);
+  internal.Clearances.assign(4 * internal.ShellCount, 0.0);
+  internal.NumberOfClearances = 0;
   // Traces step half the finest spacing of the CT and the cut field: no
   // feature of either hides between two steps and bisection finds the rest.
   double finest = 1e300;
@@ -498,11 +506,17 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
 }
 
 //------------------------------------------------------------------------------
-int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3]) const
+int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3], bool record) const
 {
   const Internals& internal = *this->Internal;
+  // Only the haptic thread's Update records: ComputeContactForce stays a pure read.
+  Internals* recording = record ? this->Internal : nullptr;
   force[0] = force[1] = force[2] = 0.0;
   int contacts = 0;
+  if (recording)
+  {
+    recording->NumberOfClearances = 0;
+  }
   for (int n = 0; n < internal.ShellCount; ++n)
   {
     const double* local = &internal.Shell[3 * n];
@@ -516,6 +530,14 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
     this->Measure(p, margins);
     if (!margins.IsSolid())
     {
+      // A point in the cut is at least the cut field's distance from the
+      // cut's surface, and so from the material beyond it.
+      if (recording && margins.Removal < 0.0)
+      {
+        double* clearance = &recording->Clearances[4 * recording->NumberOfClearances++];
+        std::copy(offset, offset + 3, clearance);
+        clearance[3] = -margins.Removal;
+      }
       continue;
     }
     // Seed 003: trace from the immersed point toward the tool's centre; the
@@ -531,9 +553,48 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
     {
       force[axis] += this->ContactStiffness * depth * u[axis];
     }
+    if (recording)
+    {
+      std::copy(u, u + 3, &recording->ContactDirections[3 * contacts]);
+    }
     ++contacts;
   }
   return contacts;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticForceModel::ProxyMove(const double proxy[3], const double hand[3], int contacts, const double contact[3], double move[3]) const
+{
+  // Along the net force on the proxy (coupling pull plus the contacts'
+  // push), as far as the stiffness in that direction says: the coupling's
+  // plus each contact's share, kc (u . d)^2, as a plane facing its push
+  // would resist. Counting every contact at full stiffness, whatever its
+  // direction, stepped a third of the way back from a stroke into bone.
+  const Internals& internal = *this->Internal;
+  const double k = this->CouplingStiffness;
+  double net[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    net[axis] = k * (hand[axis] - proxy[axis]) + contact[axis];
+  }
+  const double magnitude = Norm(net);
+  if (!(magnitude > 0.0))
+  {
+    move[0] = move[1] = move[2] = 0.0;
+    return;
+  }
+  const double d[3] = { net[0] / magnitude, net[1] / magnitude, net[2] / magnitude };
+  double stiffness = k;
+  const double* directions = internal.ContactDirections.data();
+  for (int n = 0; n < contacts; ++n)
+  {
+    const double along = vtkMath::Dot(directions + 3 * n, d);
+    stiffness += this->ContactStiffness * along * along;
+  }
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    move[axis] = magnitude / stiffness * d[axis];
+  }
 }
 
 //------------------------------------------------------------------------------
@@ -562,15 +623,30 @@ void vtkHapticForceModel::Update(const double position[3], const double rotation
   int contacts = 0;
   for (int iteration = 0; iteration < this->ProxyIterations; ++iteration)
   {
-    contacts = this->Contact(x, rotation, contact);
+    contacts = this->Contact(x, rotation, contact, true);
+    ++result.NumberOfProxySteps;
     double move[3];
-    const double stiffness = k + this->ContactStiffness * contacts;
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      move[axis] = (k * (position[axis] - x[axis]) + contact[axis]) / stiffness;
-    }
+    this->ProxyMove(x, position, contacts, contact, move);
     const double length = Norm(move);
-    const double scale = length > internal.ProxyStep ? internal.ProxyStep / length : 1.0;
+    // God-object: the proxy stops where the material ahead of it in the cut
+    // begins (just past, so that the next test finds the contact it settles
+    // on) instead of a full step into bone that the next tests must undo. A
+    // point in the cut is its cut-field distance from the cut's wall. The
+    // points facing the move (within 45 degrees) bound it: in a cavity the
+    // tool cut, their wall ahead lies along their outward normal, which the
+    // move approaches at the cosine of its angle to it (points beside the
+    // move are nearest to walls it runs along, and would stall it).
+    double limit = internal.ProxyStep;
+    for (int n = 0; n < internal.NumberOfClearances; ++n)
+    {
+      const double* record = &internal.Clearances[4 * n];
+      const double approach = vtkMath::Dot(record, move) / (Norm(record) * length);
+      if (approach > 0.7)
+      {
+        limit = std::min(limit, record[3] / approach + std::max(this->ProxyTolerance, 1e-6));
+      }
+    }
+    const double scale = length > limit ? limit / length : 1.0;
     for (int axis = 0; axis < 3; ++axis)
     {
       x[axis] += scale * move[axis];
@@ -702,6 +778,12 @@ bool vtkHapticForceModel::GetLastStepCut() const
 int vtkHapticForceModel::GetNumberOfContacts() const
 {
   return this->Internal->Last.NumberOfContacts;
+}
+
+//------------------------------------------------------------------------------
+int vtkHapticForceModel::GetNumberOfProxySteps() const
+{
+  return this->Internal->Last.NumberOfProxySteps;
 }
 
 //------------------------------------------------------------------------------

@@ -19,7 +19,12 @@
  * virtual coupling): each tick the proxy moves toward the device's pose
  * until the coupling spring (CouplingStiffness) balances the contact
  * forces, in at most ProxyIterations steps no longer than the shell's
- * spacing (so it cannot jump through thin bone). The hand feels the
+ * spacing (so it cannot jump through thin bone). Each step follows the net
+ * force as far as the stiffness in its direction says (the coupling's, and
+ * each contact's share along it), and stops where the cut ahead of the
+ * proxy ends, as the cut field's distances tell: while drilling, the proxy
+ * comes to rest on the bone the last bite left in two to four contact
+ * tests instead of stepping into it and backing out. The hand feels the
  * coupling spring plus damping of the hand's motion relative to the proxy,
  * both limited to what the device renders stably, however stiff the
  * contact is: high contact stiffness stays stable. The tool is drawn, and
@@ -252,6 +257,8 @@ public:
     double ContactForce;
     /// Vibration added along the tool axis (N, signed).
     double Vibration;
+    /// Contact tests the proxy took this tick (at most ProxyIterations).
+    int NumberOfProxySteps;
   };
 
   /**
@@ -274,6 +281,8 @@ public:
   void GetCutPosition(double position[3]) const;
   bool GetLastStepCut() const;
   int GetNumberOfContacts() const;
+  /// Contact tests the proxy took in the last Update (each tests the whole shell).
+  int GetNumberOfProxySteps() const;
   ///@}
 
   /**
@@ -297,8 +306,14 @@ protected:
   vtkHapticForceModel();
   ~vtkHapticForceModel() override;
 
-  /// Penalty force of the shell at a pose; returns the number of contacts.
-  int Contact(const double position[3], const double rotation[3][3], double force[3]) const;
+  /**
+   * Penalty force of the shell at a pose; returns the number of contacts.
+   * With record, keeps the contacts' push directions and the clearances of
+   * the points in the cut for the proxy's step (Update only: the haptic thread's).
+   */
+  int Contact(const double position[3], const double rotation[3][3], double force[3], bool record = false) const;
+  /// The proxy's step toward the hand against the last recorded contact test.
+  void ProxyMove(const double proxy[3], const double hand[3], int contacts, const double contact[3], double move[3]) const;
   /// What makes a point solid: the CT above the iso-value and the cut
   /// field not removed there (the renderer's classification).
   struct Margins

@@ -1,7 +1,8 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 // The force model against analytic scenes: a spherical burr pressed into a
-// plane, into a hole cut in it, and against the wall of a cavity cut in it. Force starts where the shell touches the
+// plane, into a hole cut in it, against the wall of a cavity cut in it, and
+// at the end of a bore it drilled. Force starts where the shell touches the
 // surface the renderer draws (the CT's iso-surface minus the cut field), to
 // well within 0.1 voxel; the proxy stays on the surface; limits, guide,
 // drilling bite, vibration and bad input behave.
@@ -304,6 +305,41 @@ int vtkHapticForceModelTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
       CHECK_DOUBLE_TOLERANCE(cavityForce[axis], expectedForce[axis], forceTolerance);
     }
   }
+
+  // 12. The burr at the end of the bore it drilled, the hand 2 mm beyond it
+  // in the bone: where each tick starts while drilling, the last bite
+  // having freed the front. The proxy stops where the material begins
+  // instead of stepping into it, and rests on the bore's end within a few
+  // contact tests: analytically, a drop delta below the end's centre where
+  // the front points' push, ContactStiffness * delta * sum(cos^2), balances
+  // the coupling's CouplingStiffness * (2 - delta).
+  const double boreEnd[3] = { 7.0, 6.5, scene.PlaneHeight - 3.0 };
+  const double boreTop[3] = { boreEnd[0], boreEnd[1], scene.PlaneHeight + 5.0 };
+  CHECK_BOOL(scene.Field->CutCapsule(boreTop, boreEnd, radius), true);
+  CHECK_BOOL(model->Prepare(), true);
+  double frontShare = 0.0;
+  for (int n = 0; n < shell->GetNumberOfPoints(); ++n)
+  {
+    double offset[3];
+    shell->GetPoint(n, offset);
+    if (offset[2] < 0.0)
+    {
+      frontShare += offset[2] * offset[2] / vtkMath::Dot(offset, offset);
+    }
+  }
+  const double coupling = model->GetCouplingStiffness();
+  const double drop = 2.0 * coupling / (model->GetContactStiffness() * frontShare + coupling);
+  const double behind[3] = { boreEnd[0], boreEnd[1], boreEnd[2] + 0.3 };
+  model->Reset(behind);
+  const double beyond[3] = { boreEnd[0], boreEnd[1], boreEnd[2] - 2.0 };
+  model->Step(beyond, 1e-3, false);
+  model->GetProxyPosition(proxy);
+  std::cout << "bore end: proxy " << proxy[2] - boreEnd[2] << " mm from the end's centre (analytic " << -drop << ") after "
+            << model->GetNumberOfProxySteps() << " contact tests, " << model->GetNumberOfContacts() << " contacts" << std::endl;
+  CHECK_BOOL(model->GetNumberOfProxySteps() <= 4, true);
+  CHECK_DOUBLE_TOLERANCE(proxy[2], boreEnd[2] - drop, 0.01);
+  CHECK_DOUBLE_TOLERANCE(proxy[0], boreEnd[0], 0.005);
+  CHECK_DOUBLE_TOLERANCE(proxy[1], boreEnd[1], 0.005);
 
   // Missing inputs are refused with a reason.
   vtkNew<vtkHapticForceModel> empty;
