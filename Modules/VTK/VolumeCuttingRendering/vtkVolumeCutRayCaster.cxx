@@ -548,6 +548,61 @@ void CopyFirstComponent(const T* in, int stride, vtkIdType count, float* out)
   }
 }
 
+/// Which fraction blocks of the scene's grid hold a corner where \a fraction is above 0.
+void MarkNonZeroBlocks(const vtkVolumeCutRayScene& scene, vtkVolumeCutRayScene::FractionVolume& fraction, int maximumThreads)
+{
+  constexpr int size = vtkVolumeCutRayScene::FractionBlockSize;
+  const int* dims = scene.Dimensions;
+  int blocks[3];
+  scene.GetFractionBlockDimensions(blocks);
+  fraction.NonZeroBlocks.assign(static_cast<size_t>(blocks[0]) * blocks[1] * blocks[2], 0);
+  if (fraction.Values.size() != static_cast<size_t>(dims[0]) * dims[1] * dims[2])
+  {
+    fraction.NonZeroBlocks.clear(); // not on the grid: every block is read
+    return;
+  }
+  const vtkIdType sy = dims[0];
+  const vtkIdType sz = static_cast<vtkIdType>(dims[0]) * dims[1];
+  // Each voxel marks the blocks of the cells it is a corner of: its own
+  // block, and the one before along an axis where it starts a block.
+  vtkVolumeCutParallelFor(maximumThreads, blocks[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+    for (vtkIdType bz = beginZ; bz < endZ; ++bz)
+    {
+      // The voxels of this layer's cells, far corners included.
+      const int k0 = static_cast<int>(bz) * size;
+      const int k1 = std::min(k0 + size, dims[2] - 1);
+      for (int by = 0; by < blocks[1]; ++by)
+      {
+        const int j0 = by * size;
+        const int j1 = std::min(j0 + size, dims[1] - 1);
+        for (int bx = 0; bx < blocks[0]; ++bx)
+        {
+          const int i0 = bx * size;
+          const int i1 = std::min(i0 + size, dims[0] - 1);
+          bool nonZero = false;
+          for (int k = k0; k <= k1 && !nonZero; ++k)
+          {
+            for (int j = j0; j <= j1 && !nonZero; ++j)
+            {
+              const float* row = fraction.Values.data() + j * sy + k * sz;
+              for (int i = i0; i <= i1; ++i)
+              {
+                // NaN counts, as interpolating it does.
+                if (!(row[i] == 0.f))
+                {
+                  nonZero = true;
+                  break;
+                }
+              }
+            }
+          }
+          fraction.NonZeroBlocks[bx + static_cast<size_t>(blocks[0]) * (by + static_cast<size_t>(blocks[1]) * bz)] = nonZero ? 1 : 0;
+        }
+      }
+    }
+  });
+}
+
 bool SameGeometry(vtkImageData* a, vtkImageData* b)
 {
   int da[3];
@@ -763,6 +818,16 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     impl.SmoothedLabelVersion = impl.LabelVersion;
     impl.BlockTime = 0;
     sceneChanged = true;
+  }
+
+  int fractionBlocks[3];
+  impl.Scene.GetFractionBlockDimensions(fractionBlocks);
+  for (vtkVolumeCutRayScene::FractionVolume& fraction : impl.Scene.Fractions)
+  {
+    if (fraction.NonZeroBlocks.size() != static_cast<size_t>(fractionBlocks[0]) * fractionBlocks[1] * fractionBlocks[2])
+    {
+      MarkNonZeroBlocks(impl.Scene, fraction, this->MaximumNumberOfThreads);
+    }
   }
 
   // Transfer functions (composite mode).
