@@ -31,6 +31,7 @@
 #include <vtkPlaneCollection.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
+#include <vtkTimerLog.h>
 
 #include <algorithm>
 #include <array>
@@ -1046,6 +1047,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   Internals& impl = *this->Impl;
   this->NumberOfRaysCast = 0;
   this->LastRenderWasLocalized = false;
+  this->LastRayCastingTime = 0.0;
   if (!worldToNDC || width < 1 || height < 1 || width > 16384 || height > 16384)
   {
     vtkErrorMacro("Render: needs a camera matrix and an image of 1 to 16384 pixels a side");
@@ -1165,6 +1167,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     this->UpdatedRegion[3] = height - 1;
   }
 
+  const double castingStart = vtkTimerLog::GetUniversalTime();
   std::atomic<vtkIdType> cast(0);
   vtkVolumeCutParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
     vtkIdType local = 0;
@@ -1184,6 +1187,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     cast += local;
   });
   this->NumberOfRaysCast = cast.load();
+  this->LastRayCastingTime = vtkTimerLog::GetUniversalTime() - castingStart;
   this->LastRenderWasLocalized = localized;
   impl.ImageValid = true;
   return true;
@@ -1210,4 +1214,5 @@ void vtkVolumeCutRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SegmentAppearances: " << this->GetNumberOfSegmentAppearances() << "\n";
   os << indent << "CutFields: " << this->Impl->Cuts.size() << "\n";
   os << indent << "NumberOfRaysCast: " << this->NumberOfRaysCast << (this->LastRenderWasLocalized ? " (localized)" : "") << "\n";
+  os << indent << "LastRayCastingTime: " << this->LastRayCastingTime << "\n";
 }
