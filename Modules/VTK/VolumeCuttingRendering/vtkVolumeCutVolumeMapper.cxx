@@ -76,7 +76,7 @@ struct vtkVolumeCutVolumeMapper::Internals
   vtkColorTransferFunction* ColorFunction = nullptr;
   vtkPiecewiseFunction* OpacityFunction = nullptr;
   std::string FallbackReason;
-  // What the last reduced CPU frame cost: its work besides casting rays
+  // What a reduced CPU frame cost: its work besides casting rays
   // (the opaque depth read back, the scene prepared, the image drawn at the
   // viewport's size), which does not shrink with the image, and its cost
   // per ray. The next interactive frame's resolution is chosen from it.
@@ -91,7 +91,14 @@ struct vtkVolumeCutVolumeMapper::Internals
     double PerRay = 0.0; // seconds
     bool Measured = false;
   };
-  FrameCost DraftCost;
+  // The last few reduced frames' (the latest at DraftCostNext - 1): a grid
+  // is sized for the dearest of them. Another program taking the cores for
+  // a frame or two (as on a shared machine) made one frame cheap and the
+  // next, sized from it, take 60 to 80 ms; the resolution comes back a few
+  // frames after the cores do.
+  static constexpr int RecentDraftFrames = 3;
+  FrameCost DraftCost[RecentDraftFrames];
+  int DraftCostNext = 0;
   // The last full frame's: whether a full frame fits.
   FrameCost FullCost;
   // What the window's frame costs besides this mapper (clearing, other
@@ -465,7 +472,11 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   impl.MapperTimeInFrame = this->LastFrameTime;
   if (path == CPUPath && caster->GetNumberOfRaysCast() > 0 && !caster->GetLastRenderWasLocalized())
   {
-    Internals::FrameCost& cost = sampleDistance > 1 ? impl.DraftCost : impl.FullCost;
+    Internals::FrameCost& cost = sampleDistance > 1 ? impl.DraftCost[impl.DraftCostNext] : impl.FullCost;
+    if (sampleDistance > 1)
+    {
+      impl.DraftCostNext = (impl.DraftCostNext + 1) % Internals::RecentDraftFrames;
+    }
     const double casting = std::min(caster->GetLastRayCastingTime(), this->LastFrameTime);
     cost.PerRay = casting / static_cast<double>(caster->GetNumberOfRaysCast());
     cost.Fixed = this->LastFrameTime - casting;
@@ -490,8 +501,10 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
     return 1;
   }
   const Internals::FrameCost& full = this->Impl->FullCost;
-  const Internals::FrameCost& draft = this->Impl->DraftCost;
-  if (!full.Measured && !draft.Measured)
+  const Internals::FrameCost* drafts = this->Impl->DraftCost;
+  const bool draftMeasured = std::any_of(
+    drafts, drafts + Internals::RecentDraftFrames, [](const Internals::FrameCost& cost) { return cost.Measured; });
+  if (!full.Measured && !draftMeasured)
   {
     // No frame measured yet: the coarsest, so that the first motion responds.
     return this->MaximumImageSampleDistance;
@@ -506,7 +519,7 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
   {
     return 1;
   }
-  if (!draft.Measured)
+  if (!draftMeasured)
   {
     // No reduced frame measured yet: the coarsest; the frames after it are
     // sized from its cost, each finer than the last until they fill the
@@ -518,7 +531,15 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
   for (int distance = 2; distance < this->MaximumImageSampleDistance; ++distance)
   {
     const double rays = static_cast<double>((width + distance - 1) / distance) * ((height + distance - 1) / distance);
-    if (draft.Fixed + draft.PerRay * rays <= allowed)
+    double predicted = 0.0;
+    for (int n = 0; n < Internals::RecentDraftFrames; ++n)
+    {
+      if (drafts[n].Measured)
+      {
+        predicted = std::max(predicted, drafts[n].Fixed + drafts[n].PerRay * rays);
+      }
+    }
+    if (predicted <= allowed)
     {
       return distance;
     }

@@ -849,19 +849,22 @@ def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
     # A full frame's rays do not tell what a reduced frame's cost (they share
     # the memory they read): the first reduced frame is the coarsest.
     window.SetDesiredUpdateRate(1000.0)
-    for _ in range(2):  # the first also makes the magnified image's shader variant
+    costs = []  # each reduced frame's work besides the rays, and its cost per ray
+    for _ in range(4):  # the first also makes the magnified image's shader variant
         renderer.GetActiveCamera().Azimuth(3.0)
         window.Render()
         assert mapper.GetLastImageSampleDistance() == 16
         assert 0.0 < caster.GetLastRayCastingTime() <= mapper.GetLastFrameTime()
+        costs.append((mapper.GetLastFrameTime() - caster.GetLastRayCastingTime(),
+                      caster.GetLastRayCastingTime() / caster.GetNumberOfRaysCast()))
 
     def rays(distance):
         return math.ceil(width / distance) ** 2
 
-    # The next ones are sized from it: its work besides the rays, and its
-    # cost per ray, at a rate that a full frame does not meet.
-    fixed = mapper.GetLastFrameTime() - caster.GetLastRayCastingTime()
-    per_ray = caster.GetLastRayCastingTime() / caster.GetNumberOfRaysCast()
+    def predicted(distance):  # the dearest of the last three reduced frames
+        return max(fixed + per_ray * rays(distance) for fixed, per_ray in costs[-3:])
+
+    # The next ones are sized from them, at a rate that a full frame does not meet.
     rest = mapper.GetRestOfFrameTime()
     rate = 4.0 / full_frame
     window.SetDesiredUpdateRate(rate)
@@ -870,7 +873,7 @@ def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
     # The rest of the window's frame is taken off the time allowed first
     # (the mapper keeps at least a fifth of it), and a tenth of it is spared.
     allowed = max(0.2 / rate, 1.0 / rate - rest)
-    expected = next((d for d in range(2, 16) if fixed + per_ray * rays(d) <= 0.9 * allowed), 16)
+    expected = next((d for d in range(2, 16) if predicted(d) <= 0.9 * allowed), 16)
     assert mapper.GetLastImageSampleDistance() == expected
     assert expected >= 2
 
