@@ -31,6 +31,7 @@
 #include <vtkPlaneCollection.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
+#include <vtkTimerLog.h>
 
 #include <algorithm>
 #include <array>
@@ -548,6 +549,61 @@ void CopyFirstComponent(const T* in, int stride, vtkIdType count, float* out)
   }
 }
 
+/// Which fraction blocks of the scene's grid hold a corner where \a fraction is above 0.
+void MarkNonZeroBlocks(const vtkVolumeCutRayScene& scene, vtkVolumeCutRayScene::FractionVolume& fraction, int maximumThreads)
+{
+  constexpr int size = vtkVolumeCutRayScene::FractionBlockSize;
+  const int* dims = scene.Dimensions;
+  int blocks[3];
+  scene.GetFractionBlockDimensions(blocks);
+  fraction.NonZeroBlocks.assign(static_cast<size_t>(blocks[0]) * blocks[1] * blocks[2], 0);
+  if (fraction.Values.size() != static_cast<size_t>(dims[0]) * dims[1] * dims[2])
+  {
+    fraction.NonZeroBlocks.clear(); // not on the grid: every block is read
+    return;
+  }
+  const vtkIdType sy = dims[0];
+  const vtkIdType sz = static_cast<vtkIdType>(dims[0]) * dims[1];
+  // Each voxel marks the blocks of the cells it is a corner of: its own
+  // block, and the one before along an axis where it starts a block.
+  vtkVolumeCutParallelFor(maximumThreads, blocks[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+    for (vtkIdType bz = beginZ; bz < endZ; ++bz)
+    {
+      // The voxels of this layer's cells, far corners included.
+      const int k0 = static_cast<int>(bz) * size;
+      const int k1 = std::min(k0 + size, dims[2] - 1);
+      for (int by = 0; by < blocks[1]; ++by)
+      {
+        const int j0 = by * size;
+        const int j1 = std::min(j0 + size, dims[1] - 1);
+        for (int bx = 0; bx < blocks[0]; ++bx)
+        {
+          const int i0 = bx * size;
+          const int i1 = std::min(i0 + size, dims[0] - 1);
+          bool nonZero = false;
+          for (int k = k0; k <= k1 && !nonZero; ++k)
+          {
+            for (int j = j0; j <= j1 && !nonZero; ++j)
+            {
+              const float* row = fraction.Values.data() + j * sy + k * sz;
+              for (int i = i0; i <= i1; ++i)
+              {
+                // NaN counts, as interpolating it does.
+                if (!(row[i] == 0.f))
+                {
+                  nonZero = true;
+                  break;
+                }
+              }
+            }
+          }
+          fraction.NonZeroBlocks[bx + static_cast<size_t>(blocks[0]) * (by + static_cast<size_t>(blocks[1]) * bz)] = nonZero ? 1 : 0;
+        }
+      }
+    }
+  });
+}
+
 bool SameGeometry(vtkImageData* a, vtkImageData* b)
 {
   int da[3];
@@ -763,6 +819,16 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     impl.SmoothedLabelVersion = impl.LabelVersion;
     impl.BlockTime = 0;
     sceneChanged = true;
+  }
+
+  int fractionBlocks[3];
+  impl.Scene.GetFractionBlockDimensions(fractionBlocks);
+  for (vtkVolumeCutRayScene::FractionVolume& fraction : impl.Scene.Fractions)
+  {
+    if (fraction.NonZeroBlocks.size() != static_cast<size_t>(fractionBlocks[0]) * fractionBlocks[1] * fractionBlocks[2])
+    {
+      MarkNonZeroBlocks(impl.Scene, fraction, this->MaximumNumberOfThreads);
+    }
   }
 
   // Transfer functions (composite mode).
@@ -981,6 +1047,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
   Internals& impl = *this->Impl;
   this->NumberOfRaysCast = 0;
   this->LastRenderWasLocalized = false;
+  this->LastRayCastingTime = 0.0;
   if (!worldToNDC || width < 1 || height < 1 || width > 16384 || height > 16384)
   {
     vtkErrorMacro("Render: needs a camera matrix and an image of 1 to 16384 pixels a side");
@@ -1100,6 +1167,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     this->UpdatedRegion[3] = height - 1;
   }
 
+  const double castingStart = vtkTimerLog::GetUniversalTime();
   std::atomic<vtkIdType> cast(0);
   vtkVolumeCutParallelFor(this->MaximumNumberOfThreads, height, [&](vtkIdType begin, vtkIdType end) {
     vtkIdType local = 0;
@@ -1119,6 +1187,7 @@ bool vtkVolumeCutRayCaster::Render(vtkMatrix4x4* worldToNDC, int width, int heig
     cast += local;
   });
   this->NumberOfRaysCast = cast.load();
+  this->LastRayCastingTime = vtkTimerLog::GetUniversalTime() - castingStart;
   this->LastRenderWasLocalized = localized;
   impl.ImageValid = true;
   return true;
@@ -1145,4 +1214,5 @@ void vtkVolumeCutRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SegmentAppearances: " << this->GetNumberOfSegmentAppearances() << "\n";
   os << indent << "CutFields: " << this->Impl->Cuts.size() << "\n";
   os << indent << "NumberOfRaysCast: " << this->NumberOfRaysCast << (this->LastRenderWasLocalized ? " (localized)" : "") << "\n";
+  os << indent << "LastRayCastingTime: " << this->LastRayCastingTime << "\n";
 }

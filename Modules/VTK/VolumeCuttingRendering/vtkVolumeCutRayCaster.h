@@ -288,6 +288,13 @@ public:
   /// Whether the last Render was a localized update.
   vtkGetMacro(LastRenderWasLocalized, bool);
 
+  /**
+   * Wall-clock seconds the last Render spent casting its rays (the rest of
+   * it prepares the scene and the image): what a frame's cost grows with
+   * the number of rays by.
+   */
+  vtkGetMacro(LastRayCastingTime, double);
+
   /// Pixel rectangle (x0, y0, x1, y1, inclusive) the last Render changed;
   /// empty (x1 < x0) when it cast no ray.
   vtkGetVector4Macro(UpdatedRegion, int);
@@ -355,6 +362,7 @@ protected:
   int MaximumNumberOfThreads = 0;
   vtkIdType NumberOfRaysCast = 0;
   bool LastRenderWasLocalized = false;
+  double LastRayCastingTime = 0.0;
   int UpdatedRegion[4] = { 0, 0, -1, -1 };
 
   bool PrepareScene(bool& sceneChanged);

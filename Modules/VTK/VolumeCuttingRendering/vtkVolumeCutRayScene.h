@@ -37,11 +37,20 @@ struct vtkVolumeCutRayScene
     bool Defined = false;
   };
 
+  /// Edge of the blocks of cells over which fractions record where they are above 0.
+  static constexpr int FractionBlockSize = 8;
+
   /// One segment's fractional labelmap: the fraction (0..1) of each voxel.
   struct FractionVolume
   {
     int Label = 0;
     std::vector<float> Values;
+    /// Per block of FractionBlockSize^3 cells (x fastest), whether a corner
+    /// of one of its cells has a fraction above 0; empty: not known. A
+    /// segment covers a few percent of the volume (a smoothed one a little
+    /// more): elsewhere its interpolated fraction is exactly 0, and a sample
+    /// weighing it there reads none of its corners, far apart in memory.
+    std::vector<uint8_t> NonZeroBlocks;
   };
 
   struct PlaneEquation
@@ -71,6 +80,22 @@ struct vtkVolumeCutRayScene
   bool AnyShapeSegment = false;
 
   bool HasSegments() const { return !this->Labels.empty() || !this->Fractions.empty(); }
+
+  /// The fraction blocks along each axis, and the block of a cell.
+  void GetFractionBlockDimensions(int blocks[3]) const
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      blocks[axis] = (this->Dimensions[axis] - 1 + FractionBlockSize - 1) / FractionBlockSize;
+    }
+  }
+  vtkIdType FractionBlockOf(const int cell[3]) const
+  {
+    int blocks[3];
+    this->GetFractionBlockDimensions(blocks);
+    return cell[0] / FractionBlockSize +
+      static_cast<vtkIdType>(blocks[0]) * (cell[1] / FractionBlockSize + static_cast<vtkIdType>(blocks[1]) * (cell[2] / FractionBlockSize));
+  }
 
   /// Cut fields with removed material, on the anatomy's grid.
   std::vector<vtkVolumeCutField*> CutFields;

@@ -208,6 +208,12 @@ public:
     int base[3];
     double f[3];
     this->CellOf(p, base, f);
+    return this->InterpolateInCell(values, base, f);
+  }
+
+  /// The trilinear value of \a values in the cell at \a base, at offsets \a f in it.
+  float InterpolateInCell(const float* values, const int base[3], const double f[3]) const
+  {
     const vtkIdType sx = 1;
     const vtkIdType sy = this->Scene.Dimensions[0];
     const vtkIdType sz = static_cast<vtkIdType>(this->Scene.Dimensions[0]) * this->Scene.Dimensions[1];
@@ -262,13 +268,15 @@ public:
       }
       weights[slot] += w;
     }
+    const vtkIdType block = scene.Fractions.empty() ? 0 : scene.FractionBlockOf(base);
     for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
     {
       if (!acceptFraction(fraction.Label))
       {
         continue;
       }
-      const double w = this->InterpolateArray(fraction.Values.data(), p);
+      // The cell found once for all fractions; 0 where every corner is.
+      const double w = this->FractionInCell(fraction, block, base, f);
       int slot = 0;
       while (slot < count && labels[slot] != fraction.Label)
       {
@@ -423,20 +431,20 @@ public:
   double Indicator(int label, const double p[3]) const
   {
     const vtkVolumeCutRayScene& scene = this->Scene;
+    int base[3];
+    double f[3];
+    this->CellOf(p, base, f);
     for (const vtkVolumeCutRayScene::FractionVolume& fraction : scene.Fractions)
     {
       if (fraction.Label == label)
       {
-        return this->InterpolateArray(fraction.Values.data(), p);
+        return this->FractionInCell(fraction, scene.FractionBlockOf(base), base, f);
       }
     }
     if (scene.Labels.empty())
     {
       return 0.0;
     }
-    int base[3];
-    double f[3];
-    this->CellOf(p, base, f);
     double value = 0.0;
     for (int corner = 0; corner < 8; ++corner)
     {
@@ -522,6 +530,17 @@ public:
   }
 
 private:
+  /// A fraction in the cell at \a base (in fraction block \a block): exactly
+  /// what InterpolateArray gives, 0 without reading where all corners are.
+  float FractionInCell(const vtkVolumeCutRayScene::FractionVolume& fraction, vtkIdType block, const int base[3], const double f[3]) const
+  {
+    if (!fraction.NonZeroBlocks.empty() && !fraction.NonZeroBlocks[block])
+    {
+      return 0.f;
+    }
+    return this->InterpolateInCell(fraction.Values.data(), base, f);
+  }
+
   const vtkVolumeCutRayScene& Scene;
 };
 

@@ -76,15 +76,31 @@ struct vtkVolumeCutVolumeMapper::Internals
   vtkColorTransferFunction* ColorFunction = nullptr;
   vtkPiecewiseFunction* OpacityFunction = nullptr;
   std::string FallbackReason;
-  // Measured cost of a CPU frame per ray cast (drawing included), 0 before
-  // the first: what an interactive frame's resolution is chosen from.
-  double SecondsPerRay = 0.0;
-  // The same for the last reduced frame, 0 before the first. A reduced ray
-  // costs more than a full frame's (no ambient occlusion, but the frame's
-  // fixed work spread over a few thousand rays, not 800 000): the first
-  // moving frame after a still one, sized from the full frame's cost, got a
-  // finer grid than the frames after it.
-  double DraftSecondsPerRay = 0.0;
+  // What a reduced CPU frame cost: its work besides casting rays
+  // (the opaque depth read back, the scene prepared, the image drawn at the
+  // viewport's size), which does not shrink with the image, and its cost
+  // per ray. The next interactive frame's resolution is chosen from it.
+  // Not from a full frame's: its rays lie next to each other and share
+  // the memory they read, while a reduced frame's each read their own and
+  // cost up to twice as much (1.2 against 2.2 microseconds on the
+  // patient-scale CT), so the first moving frame, sized from a full one,
+  // took 60 to 70 ms of a 50 ms frame.
+  struct FrameCost
+  {
+    double Fixed = 0.0;  // seconds
+    double PerRay = 0.0; // seconds
+    bool Measured = false;
+  };
+  // The last few reduced frames' (the latest at DraftCostNext - 1): a grid
+  // is sized for the dearest of them. Another program taking the cores for
+  // a frame or two (as on a shared machine) made one frame cheap and the
+  // next, sized from it, take 60 to 80 ms; the resolution comes back a few
+  // frames after the cores do.
+  static constexpr int RecentDraftFrames = 3;
+  FrameCost DraftCost[RecentDraftFrames];
+  int DraftCostNext = 0;
+  // The last full frame's: whether a full frame fits.
+  FrameCost FullCost;
   // What the window's frame costs besides this mapper (clearing, other
   // props, compositing and swapping): an interactive frame leaves it its
   // share of the time the window allows.
@@ -456,8 +472,15 @@ void vtkVolumeCutVolumeMapper::Render(vtkRenderer* renderer, vtkVolume* volume)
   impl.MapperTimeInFrame = this->LastFrameTime;
   if (path == CPUPath && caster->GetNumberOfRaysCast() > 0 && !caster->GetLastRenderWasLocalized())
   {
-    (sampleDistance > 1 ? impl.DraftSecondsPerRay : impl.SecondsPerRay) =
-      this->LastFrameTime / static_cast<double>(caster->GetNumberOfRaysCast());
+    Internals::FrameCost& cost = sampleDistance > 1 ? impl.DraftCost[impl.DraftCostNext] : impl.FullCost;
+    if (sampleDistance > 1)
+    {
+      impl.DraftCostNext = (impl.DraftCostNext + 1) % Internals::RecentDraftFrames;
+    }
+    const double casting = std::min(caster->GetLastRayCastingTime(), this->LastFrameTime);
+    cost.PerRay = casting / static_cast<double>(caster->GetNumberOfRaysCast());
+    cost.Fixed = this->LastFrameTime - casting;
+    cost.Measured = true;
   }
 }
 
@@ -477,21 +500,51 @@ int vtkVolumeCutVolumeMapper::ChooseImageSampleDistance(vtkRenderer* renderer, i
   {
     return 1;
   }
-  const double secondsPerRay = this->Impl->DraftSecondsPerRay > 0.0 ? this->Impl->DraftSecondsPerRay : this->Impl->SecondsPerRay;
-  if (secondsPerRay <= 0.0)
+  const Internals::FrameCost& full = this->Impl->FullCost;
+  const Internals::FrameCost* drafts = this->Impl->DraftCost;
+  const bool draftMeasured = std::any_of(
+    drafts, drafts + Internals::RecentDraftFrames, [](const Internals::FrameCost& cost) { return cost.Measured; });
+  if (!full.Measured && !draftMeasured)
   {
     // No frame measured yet: the coarsest, so that the first motion responds.
     return this->MaximumImageSampleDistance;
   }
   // The rest of the window's frame takes its time first; the mapper keeps
   // at least a fifth of the frame, so that a slow window does not leave it
-  // nothing but the coarsest image.
-  const double allowed = std::max(0.2 / rate, 1.0 / rate - this->Impl->RestOfFrame);
-  // Rays cost about the same each, so the distance goes with the square root
-  // of the full frame's time over the time allowed.
-  const double fullFrame = secondsPerRay * width * height;
-  const int distance = static_cast<int>(std::ceil(std::sqrt(fullFrame / allowed)));
-  return std::max(1, std::min(this->MaximumImageSampleDistance, distance));
+  // nothing but the coarsest image. A tenth of the time is spared: the
+  // same grid's cost varies by a few percent from one frame to the next as
+  // the view turns.
+  const double allowed = 0.9 * std::max(0.2 / rate, 1.0 / rate - this->Impl->RestOfFrame);
+  if (full.Measured && full.Fixed + full.PerRay * width * height <= allowed)
+  {
+    return 1;
+  }
+  if (!draftMeasured)
+  {
+    // No reduced frame measured yet: the coarsest; the frames after it are
+    // sized from its cost, each finer than the last until they fill the
+    // time (a sparser grid's rays cost more each: the estimate errs
+    // towards the coarser).
+    return this->MaximumImageSampleDistance;
+  }
+  // The finest grid whose frame fits.
+  for (int distance = 2; distance < this->MaximumImageSampleDistance; ++distance)
+  {
+    const double rays = static_cast<double>((width + distance - 1) / distance) * ((height + distance - 1) / distance);
+    double predicted = 0.0;
+    for (int n = 0; n < Internals::RecentDraftFrames; ++n)
+    {
+      if (drafts[n].Measured)
+      {
+        predicted = std::max(predicted, drafts[n].Fixed + drafts[n].PerRay * rays);
+      }
+    }
+    if (predicted <= allowed)
+    {
+      return distance;
+    }
+  }
+  return this->MaximumImageSampleDistance;
 }
 
 //------------------------------------------------------------------------------

@@ -41,10 +41,13 @@
  * styles and Slicer's camera widget raise it while the camera moves; the
  * displayable manager raises it while a stroke is drawn). An interactive
  * CPU frame casts one ray per ImageSampleDistance x ImageSampleDistance
- * pixels, the distance chosen from the measured cost of a ray so that the
- * window's whole frame fits in 1 / DesiredUpdateRate (the rest of the
+ * pixels, the distance chosen from the last reduced frame's measured cost
+ * (its fixed work and its cost per ray) so that the window's whole frame
+ * fits in 1 / DesiredUpdateRate with a tenth to spare (the rest of the
  * frame, measured between the window's StartEvent and EndEvent, is taken
- * off first), without ambient occlusion; the image is magnified. The first
+ * off first; the full image where the last full frame fits, the coarsest
+ * before any reduced frame), without ambient occlusion; the image is
+ * magnified. The first
  * still render (the rate lowered again when the motion stops) casts every
  * pixel and is the same image as a render that never interacted.
  *

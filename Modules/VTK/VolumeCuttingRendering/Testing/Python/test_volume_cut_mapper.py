@@ -835,29 +835,47 @@ def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
     renderer.SetActiveCamera(A.make_camera(scene, 4.0, width, width))
     mapper, _ = add_cut_volume(scene, intensities, scene.cut_field(1), renderer)
     mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    caster = mapper.GetRayCaster()
     window.Render()  # shaders and textures made
     renderer.GetActiveCamera().Azimuth(3.0)
     window.Render()
-    # A rate the last full frame meets leaves the image at full resolution;
-    # one that allows a sixteenth of it (within the maximum) reduces it to
-    # a ray per 4 x 4 pixels.
+    # A rate the last full frame meets leaves the image at full resolution.
     window.SetDesiredUpdateRate(0.5 / mapper.GetLastFrameTime())
     renderer.GetActiveCamera().Azimuth(3.0)
     window.Render()
     assert mapper.GetLastImageSampleDistance() == 1
     full_frame = mapper.GetLastFrameTime()
+    assert mapper.GetRestOfFrameTime() > 0.0  # the window's own work was timed
+    # A full frame's rays do not tell what a reduced frame's cost (they share
+    # the memory they read): the first reduced frame is the coarsest.
+    window.SetDesiredUpdateRate(1000.0)
+    costs = []  # each reduced frame's work besides the rays, and its cost per ray
+    for _ in range(4):  # the first also makes the magnified image's shader variant
+        renderer.GetActiveCamera().Azimuth(3.0)
+        window.Render()
+        assert mapper.GetLastImageSampleDistance() == 16
+        assert 0.0 < caster.GetLastRayCastingTime() <= mapper.GetLastFrameTime()
+        costs.append((mapper.GetLastFrameTime() - caster.GetLastRayCastingTime(),
+                      caster.GetLastRayCastingTime() / caster.GetNumberOfRaysCast()))
+
+    def rays(distance):
+        return math.ceil(width / distance) ** 2
+
+    def predicted(distance):  # the dearest of the last three reduced frames
+        return max(fixed + per_ray * rays(distance) for fixed, per_ray in costs[-3:])
+
+    # The next ones are sized from them, at a rate that a full frame does not meet.
     rest = mapper.GetRestOfFrameTime()
-    assert rest > 0.0  # the window's own work was timed
-    rate = 16.0 / full_frame
+    rate = 4.0 / full_frame
     window.SetDesiredUpdateRate(rate)
     renderer.GetActiveCamera().Azimuth(3.0)
     window.Render()
     # The rest of the window's frame is taken off the time allowed first
-    # (the mapper keeps at least a fifth of it).
+    # (the mapper keeps at least a fifth of it), and a tenth of it is spared.
     allowed = max(0.2 / rate, 1.0 / rate - rest)
-    expected = min(16, math.ceil(math.sqrt(full_frame / allowed)))
-    assert abs(mapper.GetLastImageSampleDistance() - expected) <= 1
-    assert mapper.GetLastImageSampleDistance() >= 4
+    expected = next((d for d in range(2, 16) if predicted(d) <= 0.9 * allowed), 16)
+    assert mapper.GetLastImageSampleDistance() == expected
+    assert expected >= 2
 
 
 def set_transfer_functions(volume, colors, opacities):
