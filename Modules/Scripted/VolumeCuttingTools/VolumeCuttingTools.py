@@ -24,7 +24,7 @@ from slicer.ScriptedLoadableModule import (
 )
 from slicer.util import VTKObservationMixin
 
-from VolumeCuttingLib import headct, phantom, selftests, toolconfig
+from VolumeCuttingLib import hapticdrilling, headct, inputdevices, phantom, selftests, toolconfig
 
 # Read once: the parameter node's choices are fixed when the module loads.
 TOOL_PRESETS = {preset.name: preset for preset in toolconfig.load_presets()}
@@ -108,6 +108,8 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self.logic = None
         self._parameterNode = None
         self._parameterNodeGuiTag = None
+        self._drilling = None
+        self._drillTimer = None
 
     def setup(self) -> None:
         ScriptedLoadableModuleWidget.setup(self)
@@ -128,10 +130,16 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self.ui.sensibilityTable.connect("itemChanged(QTableWidgetItem*)", self.onSensibilityItemChanged)
         self.ui.refreshDevicesButton.connect("clicked(bool)", self.onRefreshDevices)
         self.ui.inputDeviceComboBox.connect("currentIndexChanged(int)", self.onInputDeviceChanged)
+        self.ui.drillButton.connect("toggled(bool)", self.onDrillToggled)
+        # The scene follows the haptic thread at display rate.
+        self._drillTimer = qt.QTimer()
+        self._drillTimer.setInterval(16)
+        self._drillTimer.connect("timeout()", self.onDrillTimer)
         self.onRefreshDevices()
         self.initializeParameterNode()
 
     def cleanup(self) -> None:
+        self._stopDrilling()
         self.removeObservers()
 
     def enter(self) -> None:
@@ -144,6 +152,7 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
             self.removeObserver(self._parameterNode, vtk.vtkCommand.ModifiedEvent, self._onParameterNodeModified)
 
     def onSceneStartClose(self, caller, event) -> None:
+        self._stopDrilling()
         self.setParameterNode(None)
 
     def onSceneEndClose(self, caller, event) -> None:
@@ -236,8 +245,13 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         combo = self.ui.inputDeviceComboBox
         wasBlocked = combo.blockSignals(True)
         combo.clear()
+        footSwitches = self.ui.footSwitchComboBox
+        footSwitches.clear()
+        footSwitches.addItem("None", "")
         for device in self.logic.listDevices():
             combo.addItem(device.label, device.device_id)
+            if device.kind == inputdevices.FOOT_SWITCH:
+                footSwitches.addItem(device.label, device.device_id)
         combo.blockSignals(wasBlocked)
         self._selectInputDevice()
 
@@ -250,6 +264,40 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
     def onInputDeviceChanged(self, index: int) -> None:
         if self._parameterNode and index >= 0:
             self._parameterNode.inputDevice = self.ui.inputDeviceComboBox.itemData(index)
+
+    def onDrillToggled(self, checked: bool) -> None:
+        if not checked:
+            self._stopDrilling()
+            return
+        view = slicer.app.layoutManager().threeDWidget(0).threeDView()
+        renderer = view.renderWindow().GetRenderers().GetFirstRenderer()
+        try:
+            self._drilling = self.logic.startDrilling(
+                self._parameterNode, renderer, view.interactor(),
+                footSwitch=self.ui.footSwitchComboBox.currentData or None,
+                falconFirmware=self.ui.falconFirmwarePathLineEdit.currentPath or None)
+        except hapticdrilling.HapticDrillingError as error:
+            slicer.util.errorDisplay(f"Drilling could not start: {error}")
+            wasBlocked = self.ui.drillButton.blockSignals(True)
+            self.ui.drillButton.checked = False
+            self.ui.drillButton.blockSignals(wasBlocked)
+            return
+        self._drillTimer.start()
+
+    def onDrillTimer(self) -> None:
+        if self._drilling is not None:
+            self._drilling.update()
+
+    def _stopDrilling(self) -> None:
+        if self._drillTimer is not None:
+            self._drillTimer.stop()
+        if self._drilling is not None:
+            self._drilling.stop()
+            self._drilling = None
+        if hasattr(self, "ui") and self.ui.drillButton.checked:
+            wasBlocked = self.ui.drillButton.blockSignals(True)
+            self.ui.drillButton.checked = False
+            self.ui.drillButton.blockSignals(wasBlocked)
 
 
 #
@@ -309,6 +357,13 @@ class VolumeCuttingToolsLogic(ScriptedLoadableModuleLogic):
 
     def listDevices(self):
         return toolconfig.list_devices()
+
+    def startDrilling(self, parameterNode, renderer, interactor, footSwitch=None, falconFirmware=None):
+        """Drill the parameter node's cut session with its input device; the running HapticDrilling (raises HapticDrillingError)."""
+        drilling = hapticdrilling.HapticDrilling(slicer.modules.volumecutting.logic())
+        drilling.start(parameterNode.cutNode, parameterNode.inputDevice, renderer, interactor,
+                       foot_switch=footSwitch, falcon_firmware=falconFirmware)
+        return drilling
 
 
 #

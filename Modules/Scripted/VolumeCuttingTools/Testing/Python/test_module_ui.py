@@ -7,12 +7,14 @@ the widget uses is a widget of the .ui.
 """
 
 import ast
+import re
 import py_compile
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 MODULE_DIR = Path(__file__).resolve().parents[2]
 MODULE_FILE = MODULE_DIR / "VolumeCuttingTools.py"
+CMAKE_FILE = MODULE_DIR / "CMakeLists.txt"
 UI_FILE = MODULE_DIR / "Resources" / "UI" / "VolumeCuttingTools.ui"
 
 
@@ -53,3 +55,12 @@ def test_widgets_the_module_uses_are_in_the_ui():
             if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute) and node.value.attr == "ui"}
     assert used, "no self.ui.<widget> found: the check would prove nothing"
     assert used <= set(ui_widgets()), used - set(ui_widgets())
+
+
+def test_the_slicer_build_installs_every_library_module():
+    """Desktop Slicer gets only what MODULE_PYTHON_SCRIPTS lists; a module left out fails to import there."""
+    listed = set(re.findall(r"VolumeCuttingLib/\w+\.py", CMAKE_FILE.read_text()))
+    present = {f"VolumeCuttingLib/{path.name}" for path in (MODULE_DIR / "VolumeCuttingLib").glob("*.py")}
+    assert present, "no library modules found: the check would prove nothing"
+    assert present <= listed, present - listed
+    assert listed <= present, listed - present
