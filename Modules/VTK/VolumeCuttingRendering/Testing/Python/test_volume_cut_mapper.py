@@ -871,9 +871,9 @@ def test_interactive_frames_fit_the_time_the_window_allows(scene, intensities):
     renderer.GetActiveCamera().Azimuth(3.0)
     window.Render()
     # The rest of the window's frame is taken off the time allowed first
-    # (the mapper keeps at least a fifth of it), and a tenth of it is spared.
+    # (the mapper keeps at least a fifth of it), and a fifth of it is spared.
     allowed = max(0.2 / rate, 1.0 / rate - rest)
-    expected = next((d for d in range(2, 16) if predicted(d) <= 0.9 * allowed), 16)
+    expected = next((d for d in range(2, 16) if predicted(d) <= 0.8 * allowed), 16)
     assert mapper.GetLastImageSampleDistance() == expected
     assert expected >= 2
 
