@@ -7,7 +7,7 @@
  * Draws one full-viewport quad whose fragment shader casts the pixel's ray
  * through the scene prepared by a vtkVolumeCutRayCaster: the CT and labels as
  * 3D textures fetched texel by texel (the same trilinear arithmetic as the
- * CPU), each cut field as a page table (one texel a brick) and an atlas of
+ * CPU; 16-bit or 8-bit where lossless, see NormalizedTextures), each cut field as a page table (one texel a brick) and an atlas of
  * 8^3 bricks in which only bricks modified since the last frame are
  * re-uploaded (vtkVolumeCutField's modification stamps). It writes colour
  * (premultiplied) and the depth of the first visible surface.
@@ -151,6 +151,33 @@ public:
   /// GPU memory (bytes) held by this object's textures.
   size_t GetTextureMemorySize() const;
 
+  ///@{
+  /**
+   * Set/get whether the CT and the label map may be uploaded as unsigned
+   * normalized integer textures where that loses nothing: the CT as R16
+   * (value - minimum) when each value is the minimum plus an integer 0..65535
+   * (integers spanning at most 65536 values, or such integers all shifted
+   * by one offset), R32F otherwise; the labels as R8 (labels up to 255) or
+   * R16.
+   * Half the memory and bandwidth of R32F or less, and the shader reads the
+   * very floats it read from R32F. Off keeps both R32F (to compare the two).
+   * Default is true; a change uploads them again at the next Render.
+   */
+  vtkSetMacro(NormalizedTextures, bool);
+  vtkGetMacro(NormalizedTextures, bool);
+  vtkBooleanMacro(NormalizedTextures, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Bytes a voxel of the CT texture and of the label texture take on the
+   * GPU, as the driver reports them for the last upload (GL_TEXTURE_RED_SIZE):
+   * 2 for R16, 4 for R32F, 1 for R8; 0 before the first upload.
+   */
+  vtkGetMacro(AnatomyTextureBytesPerVoxel, int);
+  vtkGetMacro(LabelTextureBytesPerVoxel, int);
+  ///@}
+
   void ReleaseGraphicsResources(vtkWindow* window);
 
   /**
@@ -180,6 +207,9 @@ protected:
   int NumberOfProgramBinaryFormats = 0;
   vtkIdType NumberOfBricksUploaded = 0;
   vtkIdType TotalNumberOfBricksUploaded = 0;
+  bool NormalizedTextures = true;
+  int AnatomyTextureBytesPerVoxel = 0;
+  int LabelTextureBytesPerVoxel = 0;
 
 private:
   vtkVolumeCutOpenGLRayCaster(const vtkVolumeCutOpenGLRayCaster&) = delete;
