@@ -182,9 +182,9 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     return Texture3D(window, x, y, z, components, VTK_FLOAT, 0, data);
   }
 
-  // One component of unsigned normalized integers (GL_R8 from unsigned
-  // char, GL_R16 from unsigned short) or floats (internalFormat 0: VTK's
-  // choice for the type, R32F/RGBA32F for floats).
+  // Unsigned normalized integers (GL_R8 from unsigned char, GL_R16 or
+  // GL_RGBA16 from unsigned short) or floats (internalFormat 0: VTK's choice
+  // for the type, R32F/RGBA32F for floats).
   static vtkSmartPointer<vtkTextureObject> Texture3D(vtkOpenGLRenderWindow* window, int x, int y, int z, int components,
     int vtkType, unsigned int internalFormat, const void* data)
   {
@@ -198,7 +198,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     if (internalFormat != 0)
     {
       texture->SetInternalFormat(internalFormat);
-      texture->SetFormat(GL_RED);
+      texture->SetFormat(components == 4 ? GL_RGBA : GL_RED);
     }
     if (!texture->Create3DFromRaw(x, y, z, components, vtkType, const_cast<void*>(data)))
     {
@@ -207,8 +207,8 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     return texture;
   }
 
-  // Bytes per voxel of a one-component 3D texture as the driver stores it
-  // (0 where the driver made none, e.g. a format it does not offer).
+  // Bytes per voxel of the first component of a 3D texture as the driver
+  // stores it (0 where the driver made none, e.g. a format it does not offer).
   static int BytesPerVoxel(vtkTextureObject* texture)
   {
     GLint bits = 0;
@@ -612,17 +612,43 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
       impl.LabelScale = 1.f;
     }
     this->LabelTextureBytesPerVoxel = impl.Labels && view.Labels ? Internals::BytesPerVoxel(impl.Labels) : 0;
-    // Up to four segments' fractions, one per channel.
-    std::vector<float> fractions(view.Fractions.empty() ? 32 : 4 * voxels, 0.f);
-    for (size_t i = 0; i < view.Fractions.size(); ++i)
+    // Up to four segments' fractions, one per channel: RGBA16, as the CPU
+    // holds them in 0..1 (each within 1/131070 of its value, far inside the
+    // CPU/GPU tolerance of the mapper tests), else RGBA32F.
+    impl.Fractions = nullptr;
+    if (!view.Fractions.empty() && this->NormalizedTextures)
     {
-      for (size_t n = 0; n < voxels; ++n)
+      std::vector<unsigned short> quantized(4 * voxels, 0);
+      for (size_t i = 0; i < view.Fractions.size(); ++i)
       {
-        fractions[4 * n + i] = view.Fractions[i].second[n];
+        const float* fraction = view.Fractions[i].second;
+        for (size_t n = 0; n < voxels; ++n)
+        {
+          quantized[4 * n + i] = static_cast<unsigned short>(std::min(std::max(fraction[n], 0.f), 1.f) * 65535.f + 0.5f);
+        }
+      }
+      impl.Fractions = Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, VTK_UNSIGNED_SHORT, GL_RGBA16, quantized.data());
+      if (impl.Fractions && Internals::BytesPerVoxel(impl.Fractions) == 0)
+      {
+        impl.Fractions->ReleaseGraphicsResources(window);
+        impl.Fractions = nullptr;
       }
     }
-    impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
-                                            : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
+    if (!impl.Fractions)
+    {
+      std::vector<float> fractions(view.Fractions.empty() ? 32 : 4 * voxels, 0.f);
+      for (size_t i = 0; i < view.Fractions.size(); ++i)
+      {
+        for (size_t n = 0; n < voxels; ++n)
+        {
+          fractions[4 * n + i] = view.Fractions[i].second[n];
+        }
+      }
+      impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
+                                              : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
+    }
+    this->FractionTextureBytesPerVoxel =
+      impl.Fractions && !view.Fractions.empty() ? 4 * Internals::BytesPerVoxel(impl.Fractions) : 0;
     if (!impl.Labels || !impl.Fractions)
     {
       this->LastErrorMessage = "the label map or fractional labelmaps do not fit in GPU memory";
@@ -915,6 +941,7 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NormalizedTextures: " << this->NormalizedTextures << "\n";
   os << indent << "AnatomyTextureBytesPerVoxel: " << this->AnatomyTextureBytesPerVoxel << "\n";
   os << indent << "LabelTextureBytesPerVoxel: " << this->LabelTextureBytesPerVoxel << "\n";
+  os << indent << "FractionTextureBytesPerVoxel: " << this->FractionTextureBytesPerVoxel << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ProgramStatus: " << this->ProgramStatus << " (" << this->ProgramFeatures << ", " << this->ProgramSourceLength
      << " characters)\n";

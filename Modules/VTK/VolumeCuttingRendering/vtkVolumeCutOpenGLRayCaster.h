@@ -153,15 +153,16 @@ public:
 
   ///@{
   /**
-   * Set/get whether the CT and the label map may be uploaded as unsigned
-   * normalized integer textures where that loses nothing: the CT as R16
+   * Set/get whether the CT, the label map and fractional labelmaps may be
+   * uploaded as unsigned normalized integer textures: half the memory and
+   * bandwidth of floats or less. Where that loses nothing: the CT as R16
    * (value - minimum) when each value is the minimum plus an integer 0..65535
    * (integers spanning at most 65536 values, or such integers all shifted
    * by one offset), R32F otherwise; the labels as R8 (labels up to 255) or
-   * R16.
-   * Half the memory and bandwidth of R32F or less, and the shader reads the
-   * very floats it read from R32F. Off keeps both R32F (to compare the two).
-   * Default is true; a change uploads them again at the next Render.
+   * R16. For both the shader reads the very floats it read from R32F.
+   * Fractions (0..1, one segment a channel) as RGBA16, each within 1/131070
+   * of its value. Off keeps all of them float (to compare). Default is true; a change uploads them again at the
+   * next Render.
    */
   vtkSetMacro(NormalizedTextures, bool);
   vtkGetMacro(NormalizedTextures, bool);
@@ -170,12 +171,14 @@ public:
 
   ///@{
   /**
-   * Bytes a voxel of the CT texture and of the label texture take on the
-   * GPU, as the driver reports them for the last upload (GL_TEXTURE_RED_SIZE):
-   * 2 for R16, 4 for R32F, 1 for R8; 0 before the first upload.
+   * Bytes a voxel of the CT texture, the label texture and the fractions'
+   * texture take on the GPU, as the driver reports them for the last upload
+   * (GL_TEXTURE_RED_SIZE): 2 for R16, 4 for R32F, 1 for R8, 8 for RGBA16,
+   * 16 for RGBA32F; 0 before the first upload or without such data.
    */
   vtkGetMacro(AnatomyTextureBytesPerVoxel, int);
   vtkGetMacro(LabelTextureBytesPerVoxel, int);
+  vtkGetMacro(FractionTextureBytesPerVoxel, int);
   ///@}
 
   void ReleaseGraphicsResources(vtkWindow* window);
@@ -210,6 +213,7 @@ protected:
   bool NormalizedTextures = true;
   int AnatomyTextureBytesPerVoxel = 0;
   int LabelTextureBytesPerVoxel = 0;
+  int FractionTextureBytesPerVoxel = 0;
 
 private:
   vtkVolumeCutOpenGLRayCaster(const vtkVolumeCutOpenGLRayCaster&) = delete;

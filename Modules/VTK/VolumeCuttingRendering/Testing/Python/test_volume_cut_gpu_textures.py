@@ -217,3 +217,35 @@ def test_integers_shifted_by_a_common_fraction_are_16_bits_too(scene, program_ca
     assert (unorm_bytes, float_bytes) == (2, 4)
     assert_same_image(floats, unorm)
     assert_like_cpu(window, mapper, unorm)
+
+
+@pytest.mark.parametrize("with_label_map", [False, True])
+def test_fractions_travel_as_16_bits_within_the_stated_tolerance(scene, program_cache, with_label_map):
+    """Fractions are not integers: RGBA16 holds each within 1/131070, and the image stays within the mapper tests' tolerance."""
+    from test_volume_cut_mapper import sphere_segment
+
+    n = scene.dimensions
+    fraction, binary = sphere_segment(n, tuple(scene.center / scene.spacing + [0.3, -0.2, 0.1]), 9.0)
+    values, iso = cube_values(scene, 1.5, -1024.0)
+    window, mapper = cut_view(scene, image_of(values, np.int16), iso, program_cache)
+    caster = mapper.GetRayCaster()
+    if with_label_map:
+        caster.SetLabelMap(binary)
+    caster.SetSegmentFraction(1, fraction)
+    caster.SetSegmentAppearance(1, (0.2, 0.6, 0.9), 1.0, float("nan"))
+    gpu = mapper.GetOpenGLRayCaster()
+    unorm = draw(window, mapper, GPU)
+    assert gpu.GetFractionTextureBytesPerVoxel() == 8
+    memory = gpu.GetTextureMemorySize()
+    gpu.NormalizedTexturesOff()
+    floats = draw(window, mapper, GPU)
+    assert gpu.GetFractionTextureBytesPerVoxel() == 16
+    assert gpu.GetTextureMemorySize() - memory == (2 + (3 if with_label_map else 0) + 8) * n**3
+    gpu.NormalizedTexturesOn()
+    assert np.any(unorm[0] < 1.0)
+    assert np.array_equal(unorm[0] < 1.0, floats[0] < 1.0)
+    assert np.max(np.abs(unorm[0] - floats[0])) < 1e-4
+    assert np.mean(np.max(np.abs(unorm[1] - floats[1]), axis=2) > 2) < 0.005
+    print("RGBA16 against RGBA32F fractions: depth differs by at most", np.max(np.abs(unorm[0] - floats[0])),
+          "on", np.count_nonzero(unorm[0] != floats[0]), "pixels; colour by at most", np.max(np.abs(unorm[1] - floats[1])))
+    assert_like_cpu(window, mapper, draw(window, mapper, GPU))
