@@ -7,6 +7,7 @@
 #include "vtkVolumeCutRayCaster.h"
 #include "vtkVolumeCutShaderComposer.h"
 
+#include <vtkAbstractArray.h>
 #include <vtkIdList.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
@@ -45,6 +46,46 @@ void ColumnMajor(const double rowMajor[16], float out[16])
   }
 }
 
+// Whether the CT loses nothing as a 16-bit unsigned normalized texture: each
+// value v is minimum + k (float arithmetic, as the shader adds them) for an
+// integer k in 0..65535. If so, texels holds each k and minimum is set.
+bool ToUnorm16(const float* values, size_t count, float& minimum, std::vector<unsigned short>& texels)
+{
+  if (count == 0)
+  {
+    return false;
+  }
+  // NaNs are skipped here and refused below.
+  float low = std::numeric_limits<float>::infinity();
+  float high = -std::numeric_limits<float>::infinity();
+  for (size_t n = 0; n < count; ++n)
+  {
+    low = std::min(low, values[n]);
+    high = std::max(high, values[n]);
+  }
+  if (!(static_cast<double>(high) - static_cast<double>(low) <= 65535.0))
+  {
+    return false;
+  }
+  texels.resize(count);
+  for (size_t n = 0; n < count; ++n)
+  {
+    const double offset = static_cast<double>(values[n]) - static_cast<double>(low);
+    if (!(offset >= 0.0 && offset <= 65535.0))
+    {
+      return false;
+    }
+    const int k = static_cast<int>(offset + 0.5);
+    if (low + static_cast<float>(k) != values[n])
+    {
+      return false;
+    }
+    texels[n] = static_cast<unsigned short>(k);
+  }
+  minimum = low;
+  return true;
+}
+
 struct CutTextures
 {
   vtkVolumeCutField* Field = nullptr;
@@ -72,6 +113,12 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   CutTextures Cuts[MaximumNumberOfCutFields];
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
+  // How the CT and labels were uploaded: NormalizedTextures then, the CT's
+  // format and the values that turn texels back into CT values and labels.
+  bool TexturesNormalized = false;
+  bool AnatomyUnorm16 = false;
+  float AnatomyMinimum = 0.f;
+  float LabelScale = 1.f;
   vtkMTimeType SceneVersion = 0;
   // The program for the features of the last Render, and the quad it draws.
   vtkVolumeCutProgramBuilder Builder;
@@ -116,6 +163,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     this->AnatomyVersion = 0;
     this->LabelVersion = 0;
     this->SceneVersion = 0;
+    this->AnatomyUnorm16 = false;
     this->Context = nullptr;
   }
 
@@ -131,6 +179,15 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   static vtkSmartPointer<vtkTextureObject> Texture3D(
     vtkOpenGLRenderWindow* window, int x, int y, int z, int components, const float* data)
   {
+    return Texture3D(window, x, y, z, components, VTK_FLOAT, 0, data);
+  }
+
+  // Unsigned normalized integers (GL_R8 from unsigned char, GL_R16 or
+  // GL_RGBA16 from unsigned short) or floats (internalFormat 0: VTK's choice
+  // for the type, R32F/RGBA32F for floats).
+  static vtkSmartPointer<vtkTextureObject> Texture3D(vtkOpenGLRenderWindow* window, int x, int y, int z, int components,
+    int vtkType, unsigned int internalFormat, const void* data)
+  {
     auto texture = vtkSmartPointer<vtkTextureObject>::New();
     texture->SetContext(window);
     texture->SetWrapS(vtkTextureObject::ClampToEdge);
@@ -138,11 +195,27 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     texture->SetWrapR(vtkTextureObject::ClampToEdge);
     texture->SetMinificationFilter(vtkTextureObject::Nearest);
     texture->SetMagnificationFilter(vtkTextureObject::Nearest);
-    if (!texture->Create3DFromRaw(x, y, z, components, VTK_FLOAT, const_cast<float*>(data)))
+    if (internalFormat != 0)
+    {
+      texture->SetInternalFormat(internalFormat);
+      texture->SetFormat(components == 4 ? GL_RGBA : GL_RED);
+    }
+    if (!texture->Create3DFromRaw(x, y, z, components, vtkType, const_cast<void*>(data)))
     {
       return nullptr;
     }
     return texture;
+  }
+
+  // Bytes per voxel of the first component of a 3D texture as the driver
+  // stores it (0 where the driver made none, e.g. a format it does not offer).
+  static int BytesPerVoxel(vtkTextureObject* texture)
+  {
+    GLint bits = 0;
+    texture->Activate();
+    glGetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_RED_SIZE, &bits);
+    texture->Deactivate();
+    return bits / 8;
   }
 
   static vtkSmartPointer<vtkTextureObject> Texture2D(vtkOpenGLRenderWindow* window, int x, int y, int components, const float* data)
@@ -384,8 +457,9 @@ size_t vtkVolumeCutOpenGLRayCaster::GetTextureMemorySize() const
   auto add = [&bytes](vtkTextureObject* texture) {
     if (texture)
     {
+      // The size of the uploaded type is the size of each texture's format.
       bytes += static_cast<size_t>(texture->GetWidth()) * texture->GetHeight() * std::max(1u, texture->GetDepth()) *
-        texture->GetComponents() * sizeof(float);
+        texture->GetComponents() * vtkAbstractArray::GetDataTypeSize(texture->GetVTKDataType());
     }
   };
   add(this->Impl->Anatomy);
@@ -463,12 +537,40 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   // Each texture travels when what it holds changed: the CT with its values
   // or grid, labels and fractions with them, the small tables with anything.
   const size_t voxels = static_cast<size_t>(dims[0]) * dims[1] * dims[2];
-  const bool anatomyChanged = !impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion;
+  const bool anatomyChanged =
+    !impl.Anatomy || impl.AnatomyVersion != view.AnatomyVersion || impl.TexturesNormalized != this->NormalizedTextures;
   if (anatomyChanged)
   {
-    impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, view.Values);
+    impl.Anatomy = nullptr;
+    impl.AnatomyUnorm16 = false;
+    impl.TexturesNormalized = this->NormalizedTextures;
+    std::vector<unsigned short> texels;
+    float minimum = 0.f;
+    if (this->NormalizedTextures && ToUnorm16(view.Values, voxels, minimum, texels))
+    {
+      impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, VTK_UNSIGNED_SHORT, GL_R16, texels.data());
+      if (impl.Anatomy && Internals::BytesPerVoxel(impl.Anatomy) == 0)
+      {
+        // A driver without R16 textures: the floats, as before.
+        impl.Anatomy->ReleaseGraphicsResources(window);
+        impl.Anatomy = nullptr;
+      }
+      impl.AnatomyUnorm16 = impl.Anatomy != nullptr;
+      impl.AnatomyMinimum = minimum;
+    }
     if (!impl.Anatomy)
     {
+      impl.Anatomy = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, view.Values);
+    }
+    this->AnatomyTextureBytesPerVoxel = impl.Anatomy ? Internals::BytesPerVoxel(impl.Anatomy) : 0;
+    if (this->AnatomyTextureBytesPerVoxel == 0)
+    {
+      // No texture, or the driver could not allocate it (GL_OUT_OF_MEMORY).
+      if (impl.Anatomy)
+      {
+        impl.Anatomy->ReleaseGraphicsResources(window);
+        impl.Anatomy = nullptr;
+      }
       this->LastErrorMessage = "the CT does not fit in GPU memory as a float 3D texture";
       return false;
     }
@@ -476,24 +578,77 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   }
   if (anatomyChanged || !impl.Labels || !impl.Fractions || impl.LabelVersion != view.LabelVersion)
   {
-    std::vector<float> labels(view.Labels ? voxels : 8, 0.f);
-    if (view.Labels)
+    impl.Labels = nullptr;
+    if (view.Labels && this->NormalizedTextures)
     {
-      std::copy(view.Labels, view.Labels + voxels, labels.begin());
-    }
-    impl.Labels = view.Labels ? Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, labels.data())
-                              : Internals::Texture3D(window, 2, 2, 2, 1, labels.data());
-    // Up to four segments' fractions, one per channel.
-    std::vector<float> fractions(view.Fractions.empty() ? 32 : 4 * voxels, 0.f);
-    for (size_t i = 0; i < view.Fractions.size(); ++i)
-    {
-      for (size_t n = 0; n < voxels; ++n)
+      // Labels are 0..65535: R16 is always exact, R8 when they fit in a byte.
+      const unsigned short largest = *std::max_element(view.Labels, view.Labels + voxels);
+      if (largest <= 255)
       {
-        fractions[4 * n + i] = view.Fractions[i].second[n];
+        const std::vector<unsigned char> bytes(view.Labels, view.Labels + voxels);
+        impl.Labels = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, VTK_UNSIGNED_CHAR, GL_R8, bytes.data());
+        impl.LabelScale = 255.f;
+      }
+      else
+      {
+        impl.Labels = Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, VTK_UNSIGNED_SHORT, GL_R16, view.Labels);
+        impl.LabelScale = 65535.f;
+      }
+      if (impl.Labels && Internals::BytesPerVoxel(impl.Labels) == 0)
+      {
+        impl.Labels->ReleaseGraphicsResources(window);
+        impl.Labels = nullptr;
       }
     }
-    impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
-                                            : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
+    if (!impl.Labels)
+    {
+      std::vector<float> labels(view.Labels ? voxels : 8, 0.f);
+      if (view.Labels)
+      {
+        std::copy(view.Labels, view.Labels + voxels, labels.begin());
+      }
+      impl.Labels = view.Labels ? Internals::Texture3D(window, dims[0], dims[1], dims[2], 1, labels.data())
+                                : Internals::Texture3D(window, 2, 2, 2, 1, labels.data());
+      impl.LabelScale = 1.f;
+    }
+    this->LabelTextureBytesPerVoxel = impl.Labels && view.Labels ? Internals::BytesPerVoxel(impl.Labels) : 0;
+    // Up to four segments' fractions, one per channel: RGBA16, as the CPU
+    // holds them in 0..1 (each within 1/131070 of its value, far inside the
+    // CPU/GPU tolerance of the mapper tests), else RGBA32F.
+    impl.Fractions = nullptr;
+    if (!view.Fractions.empty() && this->NormalizedTextures)
+    {
+      std::vector<unsigned short> quantized(4 * voxels, 0);
+      for (size_t i = 0; i < view.Fractions.size(); ++i)
+      {
+        const float* fraction = view.Fractions[i].second;
+        for (size_t n = 0; n < voxels; ++n)
+        {
+          quantized[4 * n + i] = static_cast<unsigned short>(std::min(std::max(fraction[n], 0.f), 1.f) * 65535.f + 0.5f);
+        }
+      }
+      impl.Fractions = Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, VTK_UNSIGNED_SHORT, GL_RGBA16, quantized.data());
+      if (impl.Fractions && Internals::BytesPerVoxel(impl.Fractions) == 0)
+      {
+        impl.Fractions->ReleaseGraphicsResources(window);
+        impl.Fractions = nullptr;
+      }
+    }
+    if (!impl.Fractions)
+    {
+      std::vector<float> fractions(view.Fractions.empty() ? 32 : 4 * voxels, 0.f);
+      for (size_t i = 0; i < view.Fractions.size(); ++i)
+      {
+        for (size_t n = 0; n < voxels; ++n)
+        {
+          fractions[4 * n + i] = view.Fractions[i].second[n];
+        }
+      }
+      impl.Fractions = view.Fractions.empty() ? Internals::Texture3D(window, 2, 2, 2, 4, fractions.data())
+                                              : Internals::Texture3D(window, dims[0], dims[1], dims[2], 4, fractions.data());
+    }
+    this->FractionTextureBytesPerVoxel =
+      impl.Fractions && !view.Fractions.empty() ? 4 * Internals::BytesPerVoxel(impl.Fractions) : 0;
     if (!impl.Labels || !impl.Fractions)
     {
       this->LastErrorMessage = "the label map or fractional labelmaps do not fit in GPU memory";
@@ -575,6 +730,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   features.AmbientOcclusion = scene->GetAmbientOcclusion() && !features.Composite;
   features.ClipPlanes = std::min(static_cast<int>(view.Planes.size()), 6);
   features.ExtraDeclarations = this->ExtraFragmentDeclarations;
+  features.AnatomyUnorm16 = impl.AnatomyUnorm16;
   if (!impl.ReadyProgram(this, window, features))
   {
     return false;
@@ -616,6 +772,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniform2f("viewportSize", size);
   program->SetUniformi("hasLabels", view.Labels || !view.Fractions.empty() ? 1 : 0);
   program->SetUniformi("hasLabelMap", view.Labels ? 1 : 0);
+  program->SetUniformf("anatomyMinimum", impl.AnatomyMinimum);
+  program->SetUniformf("labelScale", impl.LabelScale);
   program->SetUniformi("fractionCount", static_cast<int>(view.Fractions.size()));
   float fractionLabels[4] = { 0.f, 0.f, 0.f, 0.f };
   for (size_t i = 0; i < view.Fractions.size(); ++i)
@@ -780,6 +938,10 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfBricksUploaded: " << this->NumberOfBricksUploaded << " (total " << this->TotalNumberOfBricksUploaded
      << ")\n";
   os << indent << "TextureMemorySize: " << this->GetTextureMemorySize() << "\n";
+  os << indent << "NormalizedTextures: " << this->NormalizedTextures << "\n";
+  os << indent << "AnatomyTextureBytesPerVoxel: " << this->AnatomyTextureBytesPerVoxel << "\n";
+  os << indent << "LabelTextureBytesPerVoxel: " << this->LabelTextureBytesPerVoxel << "\n";
+  os << indent << "FractionTextureBytesPerVoxel: " << this->FractionTextureBytesPerVoxel << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ProgramStatus: " << this->ProgramStatus << " (" << this->ProgramFeatures << ", " << this->ProgramSourceLength
      << " characters)\n";

@@ -7,7 +7,7 @@
  * Draws one full-viewport quad whose fragment shader casts the pixel's ray
  * through the scene prepared by a vtkVolumeCutRayCaster: the CT and labels as
  * 3D textures fetched texel by texel (the same trilinear arithmetic as the
- * CPU), each cut field as a page table (one texel a brick) and an atlas of
+ * CPU; 16-bit or 8-bit where lossless, see NormalizedTextures), each cut field as a page table (one texel a brick) and an atlas of
  * 8^3 bricks in which only bricks modified since the last frame are
  * re-uploaded (vtkVolumeCutField's modification stamps). It writes colour
  * (premultiplied) and the depth of the first visible surface.
@@ -151,6 +151,36 @@ public:
   /// GPU memory (bytes) held by this object's textures.
   size_t GetTextureMemorySize() const;
 
+  ///@{
+  /**
+   * Set/get whether the CT, the label map and fractional labelmaps may be
+   * uploaded as unsigned normalized integer textures: half the memory and
+   * bandwidth of floats or less. Where that loses nothing: the CT as R16
+   * (value - minimum) when each value is the minimum plus an integer 0..65535
+   * (integers spanning at most 65536 values, or such integers all shifted
+   * by one offset), R32F otherwise; the labels as R8 (labels up to 255) or
+   * R16. For both the shader reads the very floats it read from R32F.
+   * Fractions (0..1, one segment a channel) as RGBA16, each within 1/131070
+   * of its value. Off keeps all of them float (to compare). Default is true; a change uploads them again at the
+   * next Render.
+   */
+  vtkSetMacro(NormalizedTextures, bool);
+  vtkGetMacro(NormalizedTextures, bool);
+  vtkBooleanMacro(NormalizedTextures, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Bytes a voxel of the CT texture, the label texture and the fractions'
+   * texture take on the GPU, as the driver reports them for the last upload
+   * (GL_TEXTURE_RED_SIZE): 2 for R16, 4 for R32F, 1 for R8, 8 for RGBA16,
+   * 16 for RGBA32F; 0 before the first upload or without such data.
+   */
+  vtkGetMacro(AnatomyTextureBytesPerVoxel, int);
+  vtkGetMacro(LabelTextureBytesPerVoxel, int);
+  vtkGetMacro(FractionTextureBytesPerVoxel, int);
+  ///@}
+
   void ReleaseGraphicsResources(vtkWindow* window);
 
   /**
@@ -180,6 +210,10 @@ protected:
   int NumberOfProgramBinaryFormats = 0;
   vtkIdType NumberOfBricksUploaded = 0;
   vtkIdType TotalNumberOfBricksUploaded = 0;
+  bool NormalizedTextures = true;
+  int AnatomyTextureBytesPerVoxel = 0;
+  int LabelTextureBytesPerVoxel = 0;
+  int FractionTextureBytesPerVoxel = 0;
 
 private:
   vtkVolumeCutOpenGLRayCaster(const vtkVolumeCutOpenGLRayCaster&) = delete;

@@ -24,8 +24,12 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
 {
   const int cuts = std::max(features.CutFields, 0);
   std::string source = vtkVolumeCutRayCastFS;
-  const std::string defines =
+  std::string defines =
     "#define NUMBER_OF_CUTS " + std::to_string(cuts) + "\n#define CUT_SLOTS " + std::to_string(std::max(cuts, 1)) + "\n";
+  if (features.AnatomyUnorm16)
+  {
+    defines += "#define ANATOMY_UNORM16\n";
+  }
   vtkShaderProgram::Substitute(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
   vtkShaderProgram::Substitute(source, "//VolumeCut::Classification::Dec", vtkVolumeCutClassificationFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
@@ -98,5 +102,6 @@ std::string vtkVolumeCutShaderComposer::Describe(const Features& features)
   text += features.ThinBone ? " thin-bone" : "";
   text += features.AmbientOcclusion ? " occlusion" : "";
   text += features.ClipPlanes > 0 ? " planes=" + std::to_string(features.ClipPlanes) : "";
+  text += features.AnatomyUnorm16 ? " ct16" : "";
   return text;
 }

@@ -46,11 +46,13 @@ public:
     bool AmbientOcclusion = false;
     /// Clip planes (0 to 6).
     int ClipPlanes = 0;
+    /// The CT is a 16-bit unsigned normalized texture (value - minimum), not R32F.
+    bool AnatomyUnorm16 = false;
     /// GLSL added before main() (empty unless the caster was given some).
     std::string ExtraDeclarations;
   };
 
-  /// A short description of the features ("cuts=2 labels fractions=1 iso ...").
+  /// A short description of the features ("cuts=2 labels fractions=1 iso ... ct16").
   static std::string Describe(const Features& features);
 
   /// The complete fragment shader for these features.

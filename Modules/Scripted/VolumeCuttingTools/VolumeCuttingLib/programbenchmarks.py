@@ -1,5 +1,11 @@
 """Benchmark area ``gpuprogram``: building the GPU program, first start against a cached start.
 
+It also compares the CT and label textures as R32F (NormalizedTextures off,
+as before 16-bit textures) with R16/R8 (on) on the head CT and the
+patient-scale case: texture memory, and the GPU path's frame time with each,
+frames alternating in one process. On llvmpipe the frame time is a proxy
+only: a CPU rasterizer has no texture cache or memory bandwidth of a GPU's.
+
 A start is a new process (as a new start of the application), rendering the
 analytic cut cube of ``analyticscene.py`` on the GPU path; its build time is
 the mapper's ``GetLastProgramBuildTime()``: compile and link (or loading the
@@ -19,6 +25,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 from .benchmarks import machine_description, measurement
 
@@ -124,6 +132,117 @@ def _start(mesa_cache: Path, our_cache: Path, use_cache: bool, features: dict) -
     return figures
 
 
+def _image(array_kji) -> vtk.vtkImageData:
+    import vtk
+    from vtkmodules.util import numpy_support
+
+    image = vtk.vtkImageData()
+    image.SetDimensions(array_kji.shape[2], array_kji.shape[1], array_kji.shape[0])
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(array_kji).ravel(), deep=True))
+    return image
+
+
+def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256) -> dict:
+    """GPU-path figures of one CT with its label map, textures R32F (off) and R16/R8 (on), frames alternating."""
+    import time
+
+    import slicer_volumecutting as vc
+    import vtk
+
+    from .mapperbenchmarks import _finish
+
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(width, width)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(_image(ct))
+    caster = mapper.GetRayCaster()
+    caster.SetIsoValue(300.0)
+    caster.SetLabelMap(_image(labels.astype(np.uint16)))
+    for label in range(1, int(labels.max()) + 1):
+        caster.SetSegmentAppearance(label, (0.9, 0.85, 0.7), 1.0, 300.0)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    matrix = vtk.vtkMatrix4x4()
+    matrix.DeepCopy(np.asarray(ijk_to_ras, dtype=float).ravel())
+    volume.SetUserMatrix(matrix)
+    renderer.AddVolume(volume)
+    renderer.ResetCamera()
+    renderer.GetActiveCamera().Azimuth(30.0)
+    renderer.GetActiveCamera().Elevation(20.0)
+    renderer.ResetCameraClippingRange()
+    mapper.SetProgramBuildTimeLimit(600.0)
+    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
+    gpu = mapper.GetOpenGLRayCaster()
+    figures = {normalized: {"frame_s": [], "frame_cpu_s": [], "upload_frame_s": []} for normalized in (False, True)}
+
+    def frame():
+        window.Modified()
+        start, cpu = time.perf_counter(), time.process_time()
+        window.Render()
+        _finish(window)
+        if mapper.GetLastRenderPath() != vc.vtkVolumeCutVolumeMapper.GPUPath:
+            raise RuntimeError(f"gpuprogram benchmark: the GPU path did not draw: {mapper.GetGPUFallbackReason()}")
+        return time.perf_counter() - start, time.process_time() - cpu
+
+    # Both programs built before anything is timed.
+    for normalized in (False, True):
+        gpu.SetNormalizedTextures(normalized)
+        frame()
+    for _ in range(repeats):
+        for normalized in (False, True):
+            gpu.SetNormalizedTextures(normalized)
+            figures[normalized]["upload_frame_s"].append(frame()[0])
+            for _ in range(2):
+                wall, cpu = frame()
+                figures[normalized]["frame_s"].append(wall)
+                figures[normalized]["frame_cpu_s"].append(cpu)
+            figures[normalized]["texture_bytes"] = gpu.GetTextureMemorySize()
+            figures[normalized]["ct_bytes_per_voxel"] = gpu.GetAnatomyTextureBytesPerVoxel()
+            figures[normalized]["label_bytes_per_voxel"] = gpu.GetLabelTextureBytesPerVoxel()
+            figures[normalized]["features"] = gpu.GetProgramFeatures()
+    return {
+        "dimensions": [int(ct.shape[2]), int(ct.shape[1]), int(ct.shape[0])],
+        "window": [width, width],
+        "driver": gpu.GetDriverDescription(),
+        "float": figures[False],
+        "normalized": figures[True],
+    }
+
+
+def texture_formats(repeats: int) -> list[dict]:
+    from . import headct, patientscale
+
+    head, _, head_ijk_to_ras = headct.load_array()
+    patient = patientscale.generate(head=(head, head_ijk_to_ras))
+    cases = {
+        "head CT": (head, (head >= 300).astype(np.uint8), head_ijk_to_ras),
+        "patient-scale case": (patient.ct, patient.labels, patient.ijk_to_ras),
+    }
+    results = []
+    for name, (ct, labels, ijk_to_ras) in cases.items():
+        figures = _format_case(ct, labels, ijk_to_ras, repeats)
+        del ct, labels
+        driver = figures["driver"]
+        machine = machine_description(driver.split(", OpenGL")[0])
+        size = " x ".join(str(d) for d in figures["dimensions"])
+        new, old = figures["normalized"], figures["float"]
+        memory = measurement(
+            f"{name} ({size}) on the GPU path: texture memory, CT as R16 and labels as R8",
+            new["texture_bytes"] / 2**20, "MiB", "the same with CT and labels as R32F (NormalizedTextures off)",
+            old["texture_bytes"] / 2**20, 1, machine)
+        frame = measurement(
+            f"{name} ({size}) on the GPU path: frame time, CT as R16 and labels as R8 ({driver.split(',')[0]}, a proxy only)",
+            statistics.median(new["frame_s"]), "s", "the same frames with CT and labels as R32F, alternating in the same process",
+            statistics.median(old["frame_s"]), repeats, machine)
+        for result in (memory, frame):
+            result["details"] = figures
+        results += [memory, frame]
+    return results
+
+
 def gpuprogram(repeats: int) -> list[dict]:
     runs = {"first": [], "cached": [], "mesa_only": [], "ours_only": []}
     for _ in range(repeats):
@@ -169,4 +288,4 @@ def gpuprogram(repeats: int) -> list[dict]:
     ]
     for result in results:
         result["details"] = details
-    return results
+    return results + texture_formats(repeats)

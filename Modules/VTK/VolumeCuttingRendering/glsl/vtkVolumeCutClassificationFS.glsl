@@ -4,8 +4,10 @@
 // segment's object is there and the CT value (vtkVolumeCutSampleClassifier.h
 // documents it). Replaces the skeleton's VolumeCut::Classification::Dec tag.
 
-uniform sampler3D anatomyTexture;   // CT (R32F), fetched texel by texel
-uniform sampler3D labelTexture;     // labels (R32F), when hasLabels
+uniform sampler3D anatomyTexture;   // CT, fetched texel by texel: R32F, or R16 (ANATOMY_UNORM16)
+uniform float anatomyMinimum;       // R16: the CT value of texel 0
+uniform sampler3D labelTexture;     // labels, when hasLabels: R16 or R8, unsigned normalized
+uniform float labelScale;           // 65535 (R16) or 255 (R8)
 uniform sampler2D styleTexture;     // per label: (rgb, opacity), (iso, shape, 0, 0), (uncut surface rgb, 0)
 uniform int hasLabels;             // a label map or fractional labelmaps
 uniform int hasLabelMap;
@@ -15,6 +17,22 @@ uniform vec4 fractionLabels;
 uniform int styleCount;
 uniform int anyIso;
 uniform float minimumIso;
+
+// The CT value of voxel i, as the CPU holds it. A 16-bit texel stores
+// value - anatomyMinimum, an integer k as k / 65535: rounding 65535 * texel
+// gives k back exactly (the conversion errs far less than 0.5), so the sum is
+// the float the CPU has, bit for bit (the caster uploads R16 only then).
+float anatomyAt(ivec3 i)
+{
+#ifdef ANATOMY_UNORM16
+  return anatomyMinimum + round(65535.0 * texelFetch(anatomyTexture, i, 0).r);
+#else
+  return texelFetch(anatomyTexture, i, 0).r;
+#endif
+}
+
+// The label of voxel i (exact for the same reason).
+int labelAt(ivec3 i) { return int(labelScale * texelFetch(labelTexture, i, 0).r + 0.5); }
 
 void cellOf(vec3 p, out ivec3 base, out vec3 f)
 {
@@ -28,14 +46,14 @@ float intensity(vec3 p)
   ivec3 b;
   vec3 f;
   cellOf(p, b, f);
-  float v000 = texelFetch(anatomyTexture, b, 0).r;
-  float v100 = texelFetch(anatomyTexture, b + ivec3(1, 0, 0), 0).r;
-  float v010 = texelFetch(anatomyTexture, b + ivec3(0, 1, 0), 0).r;
-  float v110 = texelFetch(anatomyTexture, b + ivec3(1, 1, 0), 0).r;
-  float v001 = texelFetch(anatomyTexture, b + ivec3(0, 0, 1), 0).r;
-  float v101 = texelFetch(anatomyTexture, b + ivec3(1, 0, 1), 0).r;
-  float v011 = texelFetch(anatomyTexture, b + ivec3(0, 1, 1), 0).r;
-  float v111 = texelFetch(anatomyTexture, b + ivec3(1, 1, 1), 0).r;
+  float v000 = anatomyAt(b);
+  float v100 = anatomyAt(b + ivec3(1, 0, 0));
+  float v010 = anatomyAt(b + ivec3(0, 1, 0));
+  float v110 = anatomyAt(b + ivec3(1, 1, 0));
+  float v001 = anatomyAt(b + ivec3(0, 0, 1));
+  float v101 = anatomyAt(b + ivec3(1, 0, 1));
+  float v011 = anatomyAt(b + ivec3(0, 1, 1));
+  float v111 = anatomyAt(b + ivec3(1, 1, 1));
   float c00 = v000 + f.x * (v100 - v000);
   float c10 = v010 + f.x * (v110 - v010);
   float c01 = v001 + f.x * (v101 - v001);
@@ -89,18 +107,18 @@ int strongestLabel(vec3 p, bool materialOnly, out float weight)
   float unlabelledBright = 0.0;
   for (int corner = 0; corner < 8 && hasLabelMap != 0; ++corner)
   {
-    int label = int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5);
+    int label = labelAt(b + cornerOffset(corner));
     float w = cornerWeight(corner, f);
     if (materialOnly)
     {
-      if (!shownIsoSegment(label) || texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r < styleSurface(label).x)
+      if (!shownIsoSegment(label) || anatomyAt(b + cornerOffset(corner)) < styleSurface(label).x)
       {
         continue;
       }
     }
     else if (label == 0)
     {
-      if (anyIso != 0 && texelFetch(anatomyTexture, b + cornerOffset(corner), 0).r >= minimumIso)
+      if (anyIso != 0 && anatomyAt(b + cornerOffset(corner)) >= minimumIso)
       {
         unlabelledBright += w;
       }
@@ -187,7 +205,7 @@ float indicator(int label, vec3 p)
   float value = 0.0;
   for (int corner = 0; corner < 8; ++corner)
   {
-    if (int(texelFetch(labelTexture, b + cornerOffset(corner), 0).r + 0.5) == label)
+    if (labelAt(b + cornerOffset(corner)) == label)
     {
       value += cornerWeight(corner, f);
     }
