@@ -1058,6 +1058,10 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfBricksUploaded: " << this->NumberOfBricksUploaded << " (total " << this->TotalNumberOfBricksUploaded
      << ")\n";
   os << indent << "TextureMemorySize: " << this->GetTextureMemorySize() << "\n";
+  os << indent << "LocalizedUpdates: " << this->LocalizedUpdates << "\n";
+  os << indent << "NumberOfPixelsRecast: " << this->NumberOfPixelsRecast << (this->LastRenderWasLocalized ? " (localized)" : "")
+     << ", region " << this->UpdatedRegion[0] << " " << this->UpdatedRegion[1] << " " << this->UpdatedRegion[2] << " "
+     << this->UpdatedRegion[3] << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ProgramStatus: " << this->ProgramStatus << " (" << this->ProgramFeatures << ", " << this->ProgramSourceLength
      << " characters)\n";
