@@ -935,7 +935,8 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     std::vector<uint8_t> mask(pixels, 0);
     for (int n = 0; n < cuts; ++n)
     {
-      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(view.CutFields[n], kept.Stamps[n], reach, worldToNDCValues, width, height, mask, region);
+      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(
+        view.CutFields[n], kept.Stamps[n], reach, worldToNDCValues, width, height, mask, region);
     }
   }
   kept.Valid = false; // until the cast below is done
