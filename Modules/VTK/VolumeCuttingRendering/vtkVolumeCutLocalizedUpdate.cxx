@@ -65,16 +65,17 @@ void vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(vtkVolumeCutField* field, v
     const int x1 = std::min(width - 1, static_cast<int>(std::ceil(hi[0])) + 1);
     const int y0 = std::max(0, static_cast<int>(std::floor(lo[1])) - 1);
     const int y1 = std::min(height - 1, static_cast<int>(std::ceil(hi[1])) + 1);
+    if (x0 > x1 || y0 > y1)
+    {
+      continue; // out of view: a row's fill would run backwards
+    }
     for (int y = y0; y <= y1; ++y)
     {
       std::fill(mask.begin() + static_cast<vtkIdType>(y) * width + x0, mask.begin() + static_cast<vtkIdType>(y) * width + x1 + 1, 1);
     }
-    if (x0 <= x1 && y0 <= y1)
-    {
-      region[0] = std::min(region[0], x0);
-      region[1] = std::min(region[1], y0);
-      region[2] = std::max(region[2], x1);
-      region[3] = std::max(region[3], y1);
-    }
+    region[0] = std::min(region[0], x0);
+    region[1] = std::min(region[1], y0);
+    region[2] = std::max(region[2], x1);
+    region[3] = std::max(region[3], y1);
   }
 }

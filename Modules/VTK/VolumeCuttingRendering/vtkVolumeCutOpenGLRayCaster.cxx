@@ -3,6 +3,7 @@
 #include "vtkVolumeCutOpenGLRayCaster.h"
 
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutLocalizedUpdate.h"
 #include "vtkVolumeCutProgramBuilder.h"
 #include "vtkVolumeCutRayCaster.h"
 #include "vtkVolumeCutShaderComposer.h"
@@ -12,6 +13,7 @@
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
+#include <vtkOpenGLFramebufferObject.h>
 #include <vtkOpenGLQuadHelper.h>
 #include <vtkOpenGLRenderUtilities.h>
 #include <vtkOpenGLRenderWindow.h>
@@ -26,6 +28,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -97,6 +100,49 @@ struct CutTextures
   vtkTypeUInt64 Stamp = 0;
   int Dimensions[3] = { 0, 0, 0 };
 };
+
+// Draws the kept image into the window: the ray caster's colour and depth
+// as it wrote them, so that the window gets what a direct cast would give.
+const char* const KeptImageFragmentShader = R"GLSL(//VTK::System::Dec
+//VTK::Output::Dec
+in vec2 texCoord;
+uniform sampler2D colorTexture;
+uniform sampler2D depthTexture;
+void main()
+{
+  // The pixel the ray caster computes from the same texCoord.
+  ivec2 pixel = ivec2(texCoord * vec2(textureSize(colorTexture, 0)));
+  vec4 color = texelFetch(colorTexture, pixel, 0);
+  if (color.a <= 0.0)
+  {
+    discard; // the ray caster discards where nothing is seen
+  }
+  gl_FragData[0] = color;
+  gl_FragDepth = texelFetch(depthTexture, pixel, 0).r;
+}
+)GLSL";
+
+// The last image cast, and what it was cast from: a frame from the same
+// state but cut fields recasts only where their modified bricks project.
+struct KeptImage
+{
+  vtkSmartPointer<vtkOpenGLFramebufferObject> Framebuffer;
+  vtkSmartPointer<vtkTextureObject> Color;
+  vtkSmartPointer<vtkTextureObject> Depth;
+  std::unique_ptr<vtkOpenGLQuadHelper> Quad;
+  bool Valid = false;
+  int Width = 0;
+  int Height = 0;
+  double WorldToNDC[16] = {};
+  vtkMTimeType SceneVersion = 0;
+  vtkMTimeType AnatomyVersion = 0;
+  vtkMTimeType LabelVersion = 0;
+  std::string ProgramKey;
+  bool HadOpaqueDepth = false;
+  std::vector<float> OpaqueDepth;
+  std::vector<vtkVolumeCutField*> Fields;
+  std::vector<vtkTypeUInt64> Stamps;
+};
 }
 
 //------------------------------------------------------------------------------
@@ -111,6 +157,10 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkSmartPointer<vtkTextureObject> Transfer;
   vtkSmartPointer<vtkTextureObject> OpaqueDepth;
   CutTextures Cuts[MaximumNumberOfCutFields];
+  KeptImage Kept;
+  // What the opaque depth texture holds (it travels only when that changes).
+  bool UploadedHadOpaqueDepth = false;
+  std::vector<float> UploadedOpaqueDepth;
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
   // How the CT and labels were uploaded: NormalizedTextures then, the CT's
@@ -157,6 +207,23 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       this->QuadVAO = nullptr;
     }
     this->QuadProgram = nullptr;
+    for (vtkTextureObject* texture : { this->Kept.Color.GetPointer(), this->Kept.Depth.GetPointer() })
+    {
+      if (texture)
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
+    }
+    if (this->Kept.Framebuffer)
+    {
+      this->Kept.Framebuffer->ReleaseGraphicsResources(window);
+    }
+    if (this->Kept.Quad)
+    {
+      this->Kept.Quad->ReleaseGraphicsResources(window);
+    }
+    this->Kept = KeptImage();
+    this->UploadedOpaqueDepth.clear();
     // A build under way dies with its context; the next Render starts again.
     this->Builder.Release(window);
     this->BuiltFeatures.clear();
@@ -175,6 +242,126 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   }
 
   bool ReadyProgram(vtkVolumeCutOpenGLRayCaster* self, vtkOpenGLRenderWindow* window, const vtkVolumeCutShaderComposer::Features& features);
+
+  // A float colour and depth framebuffer of the viewport's size: the
+  // kept image holds exactly what the ray caster wrote.
+  bool AllocateKeptImage(vtkOpenGLRenderWindow* window, int width, int height)
+  {
+    KeptImage& kept = this->Kept;
+    for (vtkTextureObject* texture : { kept.Color.GetPointer(), kept.Depth.GetPointer() })
+    {
+      if (texture)
+      {
+        texture->ReleaseGraphicsResources(window);
+      }
+    }
+    if (kept.Framebuffer)
+    {
+      kept.Framebuffer->ReleaseGraphicsResources(window);
+    }
+    kept.Valid = false;
+    kept.Width = kept.Height = 0;
+    kept.Framebuffer = nullptr;
+    kept.Color = vtkSmartPointer<vtkTextureObject>::New();
+    kept.Color->SetContext(window);
+    kept.Depth = vtkSmartPointer<vtkTextureObject>::New();
+    kept.Depth->SetContext(window);
+    for (vtkTextureObject* texture : { kept.Color.GetPointer(), kept.Depth.GetPointer() })
+    {
+      texture->SetWrapS(vtkTextureObject::ClampToEdge);
+      texture->SetWrapT(vtkTextureObject::ClampToEdge);
+      texture->SetMinificationFilter(vtkTextureObject::Nearest);
+      texture->SetMagnificationFilter(vtkTextureObject::Nearest);
+    }
+    if (!kept.Color->Allocate2D(width, height, 4, VTK_FLOAT) || !kept.Depth->AllocateDepth(width, height, vtkTextureObject::Float32))
+    {
+      kept.Color = kept.Depth = nullptr;
+      return false;
+    }
+    auto framebuffer = vtkSmartPointer<vtkOpenGLFramebufferObject>::New();
+    framebuffer->SetContext(window);
+    vtkOpenGLState* state = window->GetState();
+    state->PushFramebufferBindings();
+    framebuffer->Bind();
+    framebuffer->AddColorAttachment(0, kept.Color);
+    framebuffer->AddDepthAttachment(kept.Depth);
+    framebuffer->ActivateDrawBuffers(1);
+    const char* description = nullptr;
+    const bool complete = vtkOpenGLFramebufferObject::GetFrameBufferStatus(vtkOpenGLFramebufferObject::GetDrawMode(), description);
+    state->PopFramebufferBindings();
+    if (!complete)
+    {
+      framebuffer->ReleaseGraphicsResources(window);
+      kept.Color = kept.Depth = nullptr;
+      return false;
+    }
+    kept.Framebuffer = framebuffer;
+    kept.Width = width;
+    kept.Height = height;
+    return true;
+  }
+
+  // Cast the rays of region (x0, y0, x1, y1 of the viewport) into the kept
+  // image with the program bound; the rest of it stays as it was.
+  void CastIntoKeptImage(vtkOpenGLRenderWindow* window, const int region[4])
+  {
+    vtkOpenGLState* state = window->GetState();
+    state->PushFramebufferBindings();
+    this->Kept.Framebuffer->Bind();
+    this->Kept.Framebuffer->ActivateDrawBuffers(1);
+    {
+      vtkOpenGLState::ScopedglViewport viewport(state);
+      vtkOpenGLState::ScopedglScissor scissor(state);
+      vtkOpenGLState::ScopedglEnableDisable scissorTest(state, GL_SCISSOR_TEST);
+      vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
+      vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
+      vtkOpenGLState::ScopedglDepthMask depthMask(state);
+      vtkOpenGLState::ScopedglDepthFunc depthFunc(state);
+      vtkOpenGLState::ScopedglClearColor clearColor(state);
+      vtkOpenGLState::ScopedglColorMask colorMask(state);
+      state->vtkglViewport(0, 0, this->Kept.Width, this->Kept.Height);
+      state->vtkglEnable(GL_SCISSOR_TEST);
+      state->vtkglScissor(region[0], region[1], region[2] - region[0] + 1, region[3] - region[1] + 1);
+      state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+      state->vtkglDepthMask(GL_TRUE);
+      // Where the ray caster discards (nothing seen), the cleared pixel says so.
+      state->vtkglClearColor(0.f, 0.f, 0.f, 0.f);
+      state->vtkglClearDepth(1.0);
+      state->vtkglClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      // The fragments as written, not blended: the window blends them when drawn.
+      state->vtkglDisable(GL_BLEND);
+      state->vtkglEnable(GL_DEPTH_TEST);
+      state->vtkglDepthFunc(GL_ALWAYS);
+      this->QuadVAO->Bind();
+      vtkOpenGLRenderUtilities::DrawFullScreenQuad();
+      this->QuadVAO->Release();
+    }
+    state->PopFramebufferBindings();
+  }
+
+  // Draw the kept image into the window's viewport as the ray caster would.
+  bool DrawKeptImage(vtkOpenGLRenderWindow* window)
+  {
+    KeptImage& kept = this->Kept;
+    if (!kept.Quad)
+    {
+      kept.Quad.reset(new vtkOpenGLQuadHelper(
+        window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), KeptImageFragmentShader, ""));
+    }
+    if (!kept.Quad->Program || !kept.Quad->Program->GetCompiled())
+    {
+      return false;
+    }
+    window->GetShaderCache()->ReadyShaderProgram(kept.Quad->Program);
+    kept.Color->Activate();
+    kept.Depth->Activate();
+    kept.Quad->Program->SetUniformi("colorTexture", kept.Color->GetTextureUnit());
+    kept.Quad->Program->SetUniformi("depthTexture", kept.Depth->GetTextureUnit());
+    DrawSurfaceQuad(window, kept.Quad.get());
+    kept.Color->Deactivate();
+    kept.Depth->Deactivate();
+    return true;
+  }
 
   static vtkSmartPointer<vtkTextureObject> Texture3D(
     vtkOpenGLRenderWindow* window, int x, int y, int z, int components, const float* data)
@@ -469,6 +656,8 @@ size_t vtkVolumeCutOpenGLRayCaster::GetTextureMemorySize() const
   add(this->Impl->Blocks);
   add(this->Impl->Transfer);
   add(this->Impl->OpaqueDepth);
+  add(this->Impl->Kept.Color);
+  add(this->Impl->Kept.Depth);
   for (const CutTextures& cut : this->Impl->Cuts)
   {
     add(cut.Page);
@@ -483,6 +672,10 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
 {
   this->LastErrorMessage.clear();
   this->NumberOfBricksUploaded = 0;
+  this->LastRenderWasLocalized = false;
+  this->NumberOfPixelsRecast = 0;
+  this->UpdatedRegion[0] = this->UpdatedRegion[1] = 0;
+  this->UpdatedRegion[2] = this->UpdatedRegion[3] = -1;
   Internals& impl = *this->Impl;
   if (!window || !scene || !worldToNDC || width < 1 || height < 1)
   {
@@ -696,6 +889,12 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     impl.SceneVersion = view.Version;
   }
 
+  // The counters before the upload: a brick stamped after them is recast next time.
+  std::vector<vtkTypeUInt64> currentStamps(cuts);
+  for (int n = 0; n < cuts; ++n)
+  {
+    currentStamps[n] = view.CutFields[n]->GetCurrentStamp();
+  }
   // Cut fields: only modified bricks travel.
   for (int n = 0; n < cuts; ++n)
   {
@@ -709,16 +908,30 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   }
   this->TotalNumberOfBricksUploaded += this->NumberOfBricksUploaded;
 
-  std::vector<float> depth(static_cast<size_t>(width) * height, 1.f);
-  if (opaqueDepth)
+  const size_t pixels = static_cast<size_t>(width) * height;
+  auto sameDepth = [opaqueDepth, pixels](bool had, const std::vector<float>& values) {
+    return had == (opaqueDepth != nullptr) &&
+      (!opaqueDepth || (values.size() == pixels && std::memcmp(opaqueDepth, values.data(), pixels * sizeof(float)) == 0));
+  };
+  if (!impl.OpaqueDepth || !sameDepth(impl.UploadedHadOpaqueDepth, impl.UploadedOpaqueDepth))
   {
-    std::copy(opaqueDepth, opaqueDepth + depth.size(), depth.begin());
-  }
-  impl.OpaqueDepth = Internals::Texture2D(window, width, height, 1, depth.data());
-  if (!impl.OpaqueDepth)
-  {
-    this->LastErrorMessage = "no memory for the depth texture";
-    return false;
+    std::vector<float> depth(pixels, 1.f);
+    if (opaqueDepth)
+    {
+      std::copy(opaqueDepth, opaqueDepth + pixels, depth.begin());
+    }
+    impl.OpaqueDepth = Internals::Texture2D(window, width, height, 1, depth.data());
+    if (!impl.OpaqueDepth)
+    {
+      this->LastErrorMessage = "no memory for the depth texture";
+      return false;
+    }
+    impl.UploadedHadOpaqueDepth = opaqueDepth != nullptr;
+    impl.UploadedOpaqueDepth.clear();
+    if (opaqueDepth)
+    {
+      impl.UploadedOpaqueDepth.assign(opaqueDepth, opaqueDepth + pixels);
+    }
   }
 
   vtkVolumeCutShaderComposer::Features features;
@@ -850,8 +1063,47 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     program->SetUniformf(("cutStep" + index).c_str(), static_cast<float>(0.25 * std::min({ spacing[0], spacing[1], spacing[2] })));
   }
 
+  // The kept image is this frame's but where bricks changed when nothing
+  // else did since it was cast (the CPU path's conditions for a localized update).
+  KeptImage& kept = impl.Kept;
+  const bool localized = this->LocalizedUpdates && kept.Valid && kept.Width == width && kept.Height == height &&
+    std::equal(worldToNDCValues, worldToNDCValues + 16, kept.WorldToNDC) && kept.SceneVersion == view.Version &&
+    kept.AnatomyVersion == view.AnatomyVersion && kept.LabelVersion == view.LabelVersion && kept.ProgramKey == impl.BuiltFeatures &&
+    kept.Fields == view.CutFields && sameDepth(kept.HadOpaqueDepth, kept.OpaqueDepth);
+  if (!kept.Framebuffer || kept.Width != width || kept.Height != height)
+  {
+    if (!impl.AllocateKeptImage(window, width, height))
+    {
+      for (vtkTextureObject* texture : active)
+      {
+        texture->Deactivate();
+      }
+      this->LastErrorMessage = "no framebuffer for a " + std::to_string(width) + " x " + std::to_string(height) + " image on the GPU";
+      return false;
+    }
+  }
+  int region[4] = { 0, 0, width - 1, height - 1 };
+  if (localized)
+  {
+    region[0] = width;
+    region[1] = height;
+    region[2] = region[3] = -1;
+    const double reach = std::max(features.AmbientOcclusion ? s->GetAmbientOcclusionRadius() : 0.0,
+      features.ThinBone ? s->GetThinBoneThickness() : 0.0);
+    std::vector<uint8_t> mask(pixels, 0);
+    for (int n = 0; n < cuts; ++n)
+    {
+      vtkVolumeCutLocalizedUpdate::MarkModifiedBricks(
+        view.CutFields[n], kept.Stamps[n], reach, worldToNDCValues, width, height, mask, region);
+    }
+  }
+  kept.Valid = false; // until the cast below is done
+
   const double drawStart = vtkTimerLog::GetUniversalTime();
-  DrawSurfaceQuad(window, impl.QuadVAO.GetPointer());
+  if (region[2] >= region[0] && region[3] >= region[1])
+  {
+    impl.CastIntoKeptImage(window, region);
+  }
   if (!impl.FirstDrawTimed)
   {
     // Drivers may compile the machine code at the first draw (llvmpipe
@@ -869,6 +1121,33 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   for (vtkTextureObject* texture : active)
   {
     texture->Deactivate();
+  }
+  kept.Valid = true;
+  std::copy(worldToNDCValues, worldToNDCValues + 16, kept.WorldToNDC);
+  kept.SceneVersion = view.Version;
+  kept.AnatomyVersion = view.AnatomyVersion;
+  kept.LabelVersion = view.LabelVersion;
+  kept.ProgramKey = impl.BuiltFeatures;
+  kept.Fields = view.CutFields;
+  kept.Stamps = currentStamps;
+  if (!localized)
+  {
+    kept.HadOpaqueDepth = opaqueDepth != nullptr;
+    kept.OpaqueDepth.clear();
+    if (opaqueDepth)
+    {
+      kept.OpaqueDepth.assign(opaqueDepth, opaqueDepth + pixels);
+    }
+  }
+  std::copy(region, region + 4, this->UpdatedRegion);
+  this->NumberOfPixelsRecast = region[2] >= region[0] && region[3] >= region[1]
+    ? static_cast<vtkIdType>(region[2] - region[0] + 1) * (region[3] - region[1] + 1)
+    : 0;
+  this->LastRenderWasLocalized = localized;
+  if (!impl.DrawKeptImage(window))
+  {
+    this->LastErrorMessage = "the shader that draws the kept image does not compile on this OpenGL context";
+    return false;
   }
   return true;
 }
@@ -942,6 +1221,10 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AnatomyTextureBytesPerVoxel: " << this->AnatomyTextureBytesPerVoxel << "\n";
   os << indent << "LabelTextureBytesPerVoxel: " << this->LabelTextureBytesPerVoxel << "\n";
   os << indent << "FractionTextureBytesPerVoxel: " << this->FractionTextureBytesPerVoxel << "\n";
+  os << indent << "LocalizedUpdates: " << this->LocalizedUpdates << "\n";
+  os << indent << "NumberOfPixelsRecast: " << this->NumberOfPixelsRecast << (this->LastRenderWasLocalized ? " (localized)" : "")
+     << ", region " << this->UpdatedRegion[0] << " " << this->UpdatedRegion[1] << " " << this->UpdatedRegion[2] << " "
+     << this->UpdatedRegion[3] << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ProgramStatus: " << this->ProgramStatus << " (" << this->ProgramFeatures << ", " << this->ProgramSourceLength
      << " characters)\n";

@@ -12,6 +12,13 @@
  * re-uploaded (vtkVolumeCutField's modification stamps). It writes colour
  * (premultiplied) and the depth of the first visible surface.
  *
+ * The image is cast into a framebuffer of this object's, sized to the
+ * viewport, and drawn from there into the window: when only cut fields
+ * changed since the last image (same camera, opaque depth, scene, program
+ * and viewport size, as for the CPU path's localized updates), only the
+ * rectangle over the bricks modified since then is recast (scissored), and
+ * the rest of the kept image is drawn again as it was.
+ *
  * Render() returns false with GetLastErrorMessage() set, and draws nothing,
  * when the context cannot run it (shader does not compile, volume larger than
  * the 3D texture limit, too many cut fields, texture allocation failed); the
@@ -148,6 +155,26 @@ public:
   vtkGetMacro(NumberOfBricksUploaded, vtkIdType);
   vtkGetMacro(TotalNumberOfBricksUploaded, vtkIdType);
 
+  ///@{
+  /**
+   * Set/get whether a frame in which only cut fields changed recasts only
+   * the rectangle over the modified bricks. Off, every frame recasts the
+   * whole viewport (the reference the localized image equals). Default is on.
+   */
+  vtkSetMacro(LocalizedUpdates, bool);
+  vtkGetMacro(LocalizedUpdates, bool);
+  vtkBooleanMacro(LocalizedUpdates, bool);
+  ///@}
+
+  /// Whether the last successful Render recast only the rectangle of modified bricks.
+  vtkGetMacro(LastRenderWasLocalized, bool);
+
+  /// Pixels the last successful Render recast (the viewport's, or its rectangle's; 0 when nothing changed).
+  vtkGetMacro(NumberOfPixelsRecast, vtkIdType);
+
+  /// Viewport rectangle (x0, y0, x1, y1, inclusive) the last Render recast; empty (x1 < x0) when none.
+  vtkGetVector4Macro(UpdatedRegion, int);
+
   /// GPU memory (bytes) held by this object's textures.
   size_t GetTextureMemorySize() const;
 
@@ -214,6 +241,10 @@ protected:
   int AnatomyTextureBytesPerVoxel = 0;
   int LabelTextureBytesPerVoxel = 0;
   int FractionTextureBytesPerVoxel = 0;
+  bool LocalizedUpdates = true;
+  bool LastRenderWasLocalized = false;
+  vtkIdType NumberOfPixelsRecast = 0;
+  int UpdatedRegion[4] = { 0, 0, -1, -1 };
 
 private:
   vtkVolumeCutOpenGLRayCaster(const vtkVolumeCutOpenGLRayCaster&) = delete;
