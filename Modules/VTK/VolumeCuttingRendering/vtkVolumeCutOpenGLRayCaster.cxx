@@ -138,8 +138,8 @@ struct KeptImage
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
   std::string ProgramKey;
-  bool HadOpaqueDepth = false;
-  std::vector<float> OpaqueDepth;
+  // Internals::OpaqueDepthVersion when it was cast.
+  vtkTypeUInt64 OpaqueDepthVersion = 0;
   std::vector<vtkVolumeCutField*> Fields;
   std::vector<vtkTypeUInt64> Stamps;
 };
@@ -158,9 +158,12 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkSmartPointer<vtkTextureObject> OpaqueDepth;
   CutTextures Cuts[MaximumNumberOfCutFields];
   KeptImage Kept;
-  // What the opaque depth texture holds (it travels only when that changes).
+  // What the opaque depth texture holds (it travels only when that changes),
+  // and a count of its uploads: the kept image knows by it whether the
+  // depth it was cast against is still the one in use.
   bool UploadedHadOpaqueDepth = false;
   std::vector<float> UploadedOpaqueDepth;
+  vtkTypeUInt64 OpaqueDepthVersion = 0;
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
   // How the CT and labels were uploaded: NormalizedTextures then, the CT's
@@ -909,11 +912,11 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   this->TotalNumberOfBricksUploaded += this->NumberOfBricksUploaded;
 
   const size_t pixels = static_cast<size_t>(width) * height;
-  auto sameDepth = [opaqueDepth, pixels](bool had, const std::vector<float>& values) {
-    return had == (opaqueDepth != nullptr) &&
-      (!opaqueDepth || (values.size() == pixels && std::memcmp(opaqueDepth, values.data(), pixels * sizeof(float)) == 0));
-  };
-  if (!impl.OpaqueDepth || !sameDepth(impl.UploadedHadOpaqueDepth, impl.UploadedOpaqueDepth))
+  const bool sameDepth = impl.UploadedHadOpaqueDepth == (opaqueDepth != nullptr) &&
+    (!opaqueDepth ||
+      (impl.UploadedOpaqueDepth.size() == pixels &&
+        std::memcmp(opaqueDepth, impl.UploadedOpaqueDepth.data(), pixels * sizeof(float)) == 0));
+  if (!impl.OpaqueDepth || !sameDepth)
   {
     std::vector<float> depth(pixels, 1.f);
     if (opaqueDepth)
@@ -932,6 +935,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     {
       impl.UploadedOpaqueDepth.assign(opaqueDepth, opaqueDepth + pixels);
     }
+    ++impl.OpaqueDepthVersion;
   }
 
   vtkVolumeCutShaderComposer::Features features;
@@ -1069,7 +1073,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   const bool localized = this->LocalizedUpdates && kept.Valid && kept.Width == width && kept.Height == height &&
     std::equal(worldToNDCValues, worldToNDCValues + 16, kept.WorldToNDC) && kept.SceneVersion == view.Version &&
     kept.AnatomyVersion == view.AnatomyVersion && kept.LabelVersion == view.LabelVersion && kept.ProgramKey == impl.BuiltFeatures &&
-    kept.Fields == view.CutFields && sameDepth(kept.HadOpaqueDepth, kept.OpaqueDepth);
+    kept.Fields == view.CutFields && kept.OpaqueDepthVersion == impl.OpaqueDepthVersion;
   if (!kept.Framebuffer || kept.Width != width || kept.Height != height)
   {
     if (!impl.AllocateKeptImage(window, width, height))
@@ -1130,15 +1134,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   kept.ProgramKey = impl.BuiltFeatures;
   kept.Fields = view.CutFields;
   kept.Stamps = currentStamps;
-  if (!localized)
-  {
-    kept.HadOpaqueDepth = opaqueDepth != nullptr;
-    kept.OpaqueDepth.clear();
-    if (opaqueDepth)
-    {
-      kept.OpaqueDepth.assign(opaqueDepth, opaqueDepth + pixels);
-    }
-  }
+  kept.OpaqueDepthVersion = impl.OpaqueDepthVersion;
   std::copy(region, region + 4, this->UpdatedRegion);
   this->NumberOfPixelsRecast = region[2] >= region[0] && region[3] >= region[1]
     ? static_cast<vtkIdType>(region[2] - region[0] + 1) * (region[3] - region[1] + 1)

@@ -21,3 +21,17 @@ def program_cache_in_a_temporary_folder(tmp_path_factory):
         os.environ.pop("XDG_CACHE_HOME", None)
     else:
         os.environ["XDG_CACHE_HOME"] = previous
+
+
+@pytest.fixture(scope="module")
+def scene():
+    """The analytic cut-cube scene (a module with other needs defines its own)."""
+    from VolumeCuttingLib import analyticscene
+
+    return analyticscene.default_scene()
+
+
+@pytest.fixture(scope="module")
+def intensities(scene):
+    """The scene's CT, once a module."""
+    return scene.intensities()

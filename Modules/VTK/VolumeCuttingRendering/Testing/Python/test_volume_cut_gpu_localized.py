@@ -8,22 +8,13 @@ context is whatever VTK gives offscreen (Mesa llvmpipe through EGL here).
 import numpy as np
 import pytest
 import slicer_volumecutting as vc
+import vtk
 from test_volume_cut_mapper import add_cut_volume, read_window, render_window
 
 from VolumeCuttingLib import analyticscene as A
 
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 WIDTH = 128
-
-
-@pytest.fixture(scope="module")
-def scene():
-    return A.default_scene()
-
-
-@pytest.fixture(scope="module")
-def intensities(scene):
-    return scene.intensities()
 
 
 def gpu_view(scene, intensities, pixels_per_voxel=4.0, width=WIDTH):
@@ -142,4 +133,29 @@ def test_a_stroke_outside_the_view_recasts_nothing(scene, intensities):
     for a, b in zip(before, after):
         assert np.array_equal(a, b)
     for a, b in zip(after, full_recast(window, mapper, width=64)):
+        assert np.array_equal(a, b)
+
+
+def test_opaque_geometry_appearing_forces_a_full_frame(scene, intensities):
+    # A tool drawn as a surface (an opaque prop) changes the depth the rays
+    # stop at: the kept image, cast against the old depth, is not reused.
+    window, renderer, mapper, cut = gpu_view(scene, intensities)
+    gpu = render(window, mapper)
+    render(window, mapper)
+    assert gpu.GetLastRenderWasLocalized() and gpu.GetNumberOfPixelsRecast() == 0
+    ball = vtk.vtkSphereSource()
+    ball.SetCenter(*(scene.center + np.array([0.0, 0.0, 1.0]) * scene.half_size))
+    ball.SetRadius(0.3 * scene.half_size)
+    polydata_mapper = vtk.vtkPolyDataMapper()
+    polydata_mapper.SetInputConnection(ball.GetOutputPort())
+    actor = vtk.vtkActor()
+    actor.SetMapper(polydata_mapper)
+    renderer.AddActor(actor)
+    render(window, mapper)
+    assert not gpu.GetLastRenderWasLocalized() and gpu.GetNumberOfPixelsRecast() == WIDTH * WIDTH
+    with_ball = read_window(window, WIDTH)
+    # Unchanged again: reused, and equal to a full recast.
+    render(window, mapper)
+    assert gpu.GetLastRenderWasLocalized() and gpu.GetNumberOfPixelsRecast() == 0
+    for a, b in zip(with_ball, full_recast(window, mapper)):
         assert np.array_equal(a, b)

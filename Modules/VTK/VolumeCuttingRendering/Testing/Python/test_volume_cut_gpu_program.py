@@ -34,11 +34,6 @@ def scene():
     return A.default_scene(32)
 
 
-@pytest.fixture(scope="module")
-def intensities(scene):
-    return scene.intensities()
-
-
 def cut_cube(scene, intensities, cache_directory, width=WIDTH):
     """A window showing the cut cube; the mapper keeps its program binaries in ``cache_directory``."""
     window, renderer = render_window(width)

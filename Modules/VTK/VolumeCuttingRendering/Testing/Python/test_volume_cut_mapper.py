@@ -32,16 +32,6 @@ class ErrorLog:
     _collect.CallDataType = vtk.VTK_STRING
 
 
-@pytest.fixture(scope="module")
-def scene():
-    return A.default_scene()
-
-
-@pytest.fixture(scope="module")
-def intensities(scene):
-    return scene.intensities()
-
-
 def image_array(getter, height, width, components):
     image = vtk.vtkImageData()
     getter(image)
