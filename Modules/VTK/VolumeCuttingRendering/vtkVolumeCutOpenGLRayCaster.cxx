@@ -52,6 +52,10 @@ void ColumnMajor(const double rowMajor[16], float out[16])
 // Whether the CT loses nothing as a 16-bit unsigned normalized texture: each
 // value v is minimum + k (float arithmetic, as the shader adds them) for an
 // integer k in 0..65535. If so, texels holds each k and minimum is set.
+// A cut field's distances (short quanta) travel in R16 as value + this; the
+// shader subtracts it (glsl/vtkVolumeCutCutFieldFS.glsl).
+constexpr int CutAtlasOffset = 32768;
+
 bool ToUnorm16(const float* values, size_t count, float& minimum, std::vector<unsigned short>& texels)
 {
   if (count == 0)
@@ -99,6 +103,11 @@ struct CutTextures
   std::vector<int> SlotOfBrick;
   vtkTypeUInt64 Stamp = 0;
   int Dimensions[3] = { 0, 0, 0 };
+  // The atlas as asked (NormalizedTextures) and as made: R16 holding
+  // distance + 32768, or R32F where the driver offers no R16.
+  bool Unorm16Requested = false;
+  bool Unorm16 = false;
+  int AtlasBytesPerTexel = 0;
 };
 
 // Draws the kept image into the window: the ray caster's colour and depth
@@ -425,13 +434,13 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
 
   // Bring one cut field's page table and atlas up to date; returns the
   // number of bricks uploaded, or -1 when a texture cannot be made.
-  vtkIdType UpdateCut(vtkOpenGLRenderWindow* window, CutTextures& cut, vtkVolumeCutField* field)
+  vtkIdType UpdateCut(vtkOpenGLRenderWindow* window, CutTextures& cut, vtkVolumeCutField* field, bool normalized)
   {
     const int* brickDims = field->GetBrickDimensions();
     const vtkIdType brickCount = static_cast<vtkIdType>(brickDims[0]) * brickDims[1] * brickDims[2];
     const int* dims = field->GetDimensions();
     const bool sameField = cut.Field == field && cut.Page && cut.Dimensions[0] == dims[0] && cut.Dimensions[1] == dims[1] &&
-      cut.Dimensions[2] == dims[2];
+      cut.Dimensions[2] == dims[2] && cut.Unorm16Requested == normalized;
     // The counter first: a brick stamped after it is listed next time.
     const vtkTypeUInt64 stamp = field->GetCurrentStamp();
     vtkNew<vtkIdList> modified;
@@ -469,26 +478,54 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       std::vector<float> page(brickCount, -1.f);
       cut = CutTextures();
       cut.Page = Texture3D(window, brickDims[0], brickDims[1], brickDims[2], 1, page.data());
-      std::vector<float> empty(static_cast<size_t>(8 * slots) * 8 * slots * 8 * slots, 32767.f);
-      cut.Atlas = Texture3D(window, 8 * slots, 8 * slots, 8 * slots, 1, empty.data());
+      const size_t atlasTexels = static_cast<size_t>(8 * slots) * 8 * slots * 8 * slots;
+      if (normalized)
+      {
+        // Distances are whole quanta, -32767..32767 (32767: no brick there):
+        // shifted by 32768 they fit R16 exactly, half the floats' memory and upload.
+        std::vector<unsigned short> empty(atlasTexels, static_cast<unsigned short>(32767 + CutAtlasOffset));
+        cut.Atlas = Texture3D(window, 8 * slots, 8 * slots, 8 * slots, 1, VTK_UNSIGNED_SHORT, GL_R16, empty.data());
+        if (cut.Atlas && BytesPerVoxel(cut.Atlas) == 0)
+        {
+          cut.Atlas->ReleaseGraphicsResources(window);
+          cut.Atlas = nullptr;
+        }
+        cut.Unorm16 = cut.Atlas != nullptr;
+      }
+      if (!cut.Atlas)
+      {
+        std::vector<float> empty(atlasTexels, 32767.f);
+        cut.Atlas = Texture3D(window, 8 * slots, 8 * slots, 8 * slots, 1, empty.data());
+      }
       if (!cut.Page || !cut.Atlas)
       {
         cut = CutTextures();
         return -1;
       }
+      cut.Unorm16Requested = normalized;
+      cut.AtlasBytesPerTexel = BytesPerVoxel(cut.Atlas);
       cut.Field = field;
       cut.SlotsPerAxis = slots;
       cut.SlotOfBrick.assign(brickCount, -1);
       std::copy(dims, dims + 3, cut.Dimensions);
     }
     std::vector<short> values(vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize);
-    std::vector<float> floats(values.size());
+    std::vector<float> floats(cut.Unorm16 ? 0 : values.size());
+    std::vector<unsigned short> shifted(cut.Unorm16 ? values.size() : 0);
     vtkIdType uploaded = 0;
     for (vtkIdType n = 0; n < modified->GetNumberOfIds(); ++n)
     {
       const vtkIdType id = modified->GetId(n);
       field->CopyBrick(id, values.data());
-      std::copy(values.begin(), values.end(), floats.begin());
+      if (cut.Unorm16)
+      {
+        std::transform(values.begin(), values.end(), shifted.begin(),
+          [](short value) { return static_cast<unsigned short>(value + CutAtlasOffset); });
+      }
+      else
+      {
+        std::copy(values.begin(), values.end(), floats.begin());
+      }
       int& slot = cut.SlotOfBrick[id];
       if (slot < 0)
       {
@@ -502,8 +539,17 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       const int s = cut.SlotsPerAxis;
       cut.Atlas->Bind();
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-      glTexSubImage3D(GL_TEXTURE_3D, 0, 8 * (slot % s), 8 * ((slot / s) % s), 8 * (slot / (s * s)), 8, 8, 8, GL_RED, GL_FLOAT,
-        floats.data());
+      if (cut.Unorm16)
+      {
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+        glTexSubImage3D(GL_TEXTURE_3D, 0, 8 * (slot % s), 8 * ((slot / s) % s), 8 * (slot / (s * s)), 8, 8, 8, GL_RED,
+          GL_UNSIGNED_SHORT, shifted.data());
+      }
+      else
+      {
+        glTexSubImage3D(GL_TEXTURE_3D, 0, 8 * (slot % s), 8 * ((slot / s) % s), 8 * (slot / (s * s)), 8, 8, 8, GL_RED, GL_FLOAT,
+          floats.data());
+      }
       ++uploaded;
     }
     cut.Stamp = stamp;
@@ -638,6 +684,20 @@ vtkVolumeCutOpenGLRayCaster::~vtkVolumeCutOpenGLRayCaster()
 void vtkVolumeCutOpenGLRayCaster::ReleaseGraphicsResources(vtkWindow* window)
 {
   this->Impl->Release(window);
+}
+
+//------------------------------------------------------------------------------
+vtkIdType vtkVolumeCutOpenGLRayCaster::GetCutAtlasTextureSize() const
+{
+  vtkIdType texels = 0;
+  for (const CutTextures& cut : this->Impl->Cuts)
+  {
+    if (cut.Atlas)
+    {
+      texels += static_cast<vtkIdType>(cut.Atlas->GetWidth()) * cut.Atlas->GetHeight() * cut.Atlas->GetDepth();
+    }
+  }
+  return texels;
 }
 
 //------------------------------------------------------------------------------
@@ -901,7 +961,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   // Cut fields: only modified bricks travel.
   for (int n = 0; n < cuts; ++n)
   {
-    const vtkIdType uploaded = impl.UpdateCut(window, impl.Cuts[n], view.CutFields[n]);
+    const vtkIdType uploaded = impl.UpdateCut(window, impl.Cuts[n], view.CutFields[n], this->NormalizedTextures);
     if (uploaded < 0)
     {
       this->LastErrorMessage = "cut field " + std::to_string(n) + " does not fit in GPU memory";
@@ -948,6 +1008,12 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   features.ClipPlanes = std::min(static_cast<int>(view.Planes.size()), 6);
   features.ExtraDeclarations = this->ExtraFragmentDeclarations;
   features.AnatomyUnorm16 = impl.AnatomyUnorm16;
+  features.CutAtlasUnorm16.clear();
+  for (int n = 0; n < cuts; ++n)
+  {
+    features.CutAtlasUnorm16.push_back(impl.Cuts[n].Unorm16);
+  }
+  this->CutAtlasTextureBytesPerVoxel = cuts > 0 ? impl.Cuts[0].AtlasBytesPerTexel : 0;
   if (!impl.ReadyProgram(this, window, features))
   {
     return false;
@@ -1217,6 +1283,7 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AnatomyTextureBytesPerVoxel: " << this->AnatomyTextureBytesPerVoxel << "\n";
   os << indent << "LabelTextureBytesPerVoxel: " << this->LabelTextureBytesPerVoxel << "\n";
   os << indent << "FractionTextureBytesPerVoxel: " << this->FractionTextureBytesPerVoxel << "\n";
+  os << indent << "CutAtlasTextureBytesPerVoxel: " << this->CutAtlasTextureBytesPerVoxel << "\n";
   os << indent << "LocalizedUpdates: " << this->LocalizedUpdates << "\n";
   os << indent << "NumberOfPixelsRecast: " << this->NumberOfPixelsRecast << (this->LastRenderWasLocalized ? " (localized)" : "")
      << ", region " << this->UpdatedRegion[0] << " " << this->UpdatedRegion[1] << " " << this->UpdatedRegion[2] << " "

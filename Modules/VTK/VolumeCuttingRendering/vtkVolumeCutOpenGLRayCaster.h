@@ -188,7 +188,8 @@ public:
    * by one offset), R32F otherwise; the labels as R8 (labels up to 255) or
    * R16. For both the shader reads the very floats it read from R32F.
    * Fractions (0..1, one segment a channel) as RGBA16, each within 1/131070
-   * of its value. Off keeps all of them float (to compare). Default is true; a change uploads them again at the
+   * of its value. Cut fields' atlases as R16 (their distances are whole
+   * quanta, stored + 32768), exact. Off keeps all of them float (to compare). Default is true; a change uploads them again at the
    * next Render.
    */
   vtkSetMacro(NormalizedTextures, bool);
@@ -207,6 +208,15 @@ public:
   vtkGetMacro(LabelTextureBytesPerVoxel, int);
   vtkGetMacro(FractionTextureBytesPerVoxel, int);
   ///@}
+
+  /**
+   * Bytes a texel of the first cut field's brick atlas takes on the GPU: 2
+   * for R16, 4 for R32F; 0 without a cut field.
+   */
+  vtkGetMacro(CutAtlasTextureBytesPerVoxel, int);
+
+  /// Texels of all cut fields' brick atlases (they grow by half again when full).
+  vtkIdType GetCutAtlasTextureSize() const;
 
   void ReleaseGraphicsResources(vtkWindow* window);
 
@@ -241,6 +251,7 @@ protected:
   int AnatomyTextureBytesPerVoxel = 0;
   int LabelTextureBytesPerVoxel = 0;
   int FractionTextureBytesPerVoxel = 0;
+  int CutAtlasTextureBytesPerVoxel = 0;
   bool LocalizedUpdates = true;
   bool LastRenderWasLocalized = false;
   vtkIdType NumberOfPixelsRecast = 0;

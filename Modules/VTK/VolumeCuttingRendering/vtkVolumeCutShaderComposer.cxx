@@ -30,6 +30,13 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   {
     defines += "#define ANATOMY_UNORM16\n";
   }
+  for (size_t n = 0; n < features.CutAtlasUnorm16.size(); ++n)
+  {
+    if (features.CutAtlasUnorm16[n])
+    {
+      defines += "#define CUT_ATLAS_UNORM16_" + std::to_string(n) + "\n";
+    }
+  }
   vtkShaderProgram::Substitute(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
   vtkShaderProgram::Substitute(source, "//VolumeCut::Classification::Dec", vtkVolumeCutClassificationFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
@@ -103,5 +110,7 @@ std::string vtkVolumeCutShaderComposer::Describe(const Features& features)
   text += features.AmbientOcclusion ? " occlusion" : "";
   text += features.ClipPlanes > 0 ? " planes=" + std::to_string(features.ClipPlanes) : "";
   text += features.AnatomyUnorm16 ? " ct16" : "";
+  const bool anyCut16 = std::find(features.CutAtlasUnorm16.begin(), features.CutAtlasUnorm16.end(), true) != features.CutAtlasUnorm16.end();
+  text += anyCut16 ? " cut16" : "";
   return text;
 }

@@ -25,6 +25,7 @@
 #define vtkVolumeCutShaderComposer_h
 
 #include <string>
+#include <vector>
 
 class vtkVolumeCutShaderComposer
 {
@@ -48,6 +49,8 @@ public:
     int ClipPlanes = 0;
     /// The CT is a 16-bit unsigned normalized texture (value - minimum), not R32F.
     bool AnatomyUnorm16 = false;
+    /// Per cut field: its atlas is R16 (distance + 32768), not R32F.
+    std::vector<bool> CutAtlasUnorm16;
     /// GLSL added before main() (empty unless the caster was given some).
     std::string ExtraDeclarations;
   };

@@ -14,6 +14,16 @@ uniform float cutQuantum@N@;
 uniform float cutStep@N@;
 uniform float cutCorrectionReach@N@; // in sample units
 ivec3 cutDimensions@N@;
+// The distance in quanta at atlas texel p: an R16 atlas holds distance +
+// 32768, k / 65535 for k; rounding 65535 * texel gives k back exactly.
+float cutAtlasAt@N@(ivec3 p)
+{
+#ifdef CUT_ATLAS_UNORM16_@N@
+  return round(65535.0 * texelFetch(cutAtlas@N@, p, 0).r) - 32768.0;
+#else
+  return texelFetch(cutAtlas@N@, p, 0).r;
+#endif
+}
 float cutSample@N@(ivec3 c)
 {
   if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, cutDimensions@N@)))
@@ -28,7 +38,7 @@ float cutSample@N@(ivec3 c)
   }
   int s = int(slot + 0.5);
   ivec3 origin = 8 * ivec3(s % cutSlots@N@, (s / cutSlots@N@) % cutSlots@N@, s / (cutSlots@N@ * cutSlots@N@));
-  return texelFetch(cutAtlas@N@, origin + (c - 8 * b), 0).r;
+  return cutAtlasAt@N@(origin + (c - 8 * b));
 }
 float cutDistance@N@(vec3 world)
 {

@@ -76,13 +76,13 @@ def test_programs_are_specialized_to_the_features_in_use(scene, intensities, tmp
         assert gpu.GetProgramFeatures() == expected_features
         sizes[name] = gpu.GetProgramSourceLength()
 
-    draw("iso", "cuts=1 iso ct16")
+    draw("iso", "cuts=1 iso ct16 cut16")
     caster.SetAmbientOcclusion(True)
-    draw("occlusion", "cuts=1 iso occlusion ct16")
+    draw("occlusion", "cuts=1 iso occlusion ct16 cut16")
     caster.SetAmbientOcclusion(False)
     caster.ThinBoneShadingOn()
     mapper.SetClippingPlanes(planes)
-    draw("thin bone, plane", "cuts=1 iso thin-bone planes=1 ct16")
+    draw("thin bone, plane", "cuts=1 iso thin-bone planes=1 ct16 cut16")
     # The specialized program draws what the CPU draws (the mapper tests' tolerance).
     gpu_depth, gpu_color = read_window(window, WIDTH)
     cpu_depth, cpu_color = cpu_image(window, mapper)
@@ -92,7 +92,7 @@ def test_programs_are_specialized_to_the_features_in_use(scene, intensities, tmp
     caster.ThinBoneShadingOff()
     mapper.RemoveAllClippingPlanes()
     mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
-    draw("composite", "cuts=1 composite ct16")
+    draw("composite", "cuts=1 composite ct16 cut16")
     # A stage not in use leaves its code out of the program.
     assert sizes["iso"] < sizes["thin bone, plane"] and sizes["iso"] < sizes["occlusion"] and sizes["iso"] < sizes["composite"]
     print("fragment shader characters per feature set:", sizes)
@@ -231,7 +231,7 @@ def test_a_lost_context_between_programs_builds_again(scene, intensities, tmp_pa
     window.Finalize()
     window.Render()
     assert mapper.GetLastRenderPath() == GPU, mapper.GetGPUFallbackReason()
-    assert mapper.GetOpenGLRayCaster().GetProgramFeatures() == "cuts=1 iso thin-bone ct16"
+    assert mapper.GetOpenGLRayCaster().GetProgramFeatures() == "cuts=1 iso thin-bone ct16 cut16"
     drawn = read_window(window, WIDTH)
     depth, color = cpu_image(window, mapper)
     assert np.max(np.abs(depth - drawn[0])) < 1e-4

@@ -1,8 +1,9 @@
-"""The CT and the labels on the GPU: 16-bit (or 8-bit) textures wherever that loses nothing.
+"""The CT, the labels and the cut fields on the GPU: 16-bit (or 8-bit) textures wherever that loses nothing.
 
 vtkVolumeCutOpenGLRayCaster uploads a CT whose values are integers spanning at
-most 65536 values as R16 (value - minimum), and the labels as R8 or R16; the
-shader turns each texel back into the float the CPU holds. So the image must
+most 65536 values as R16 (value - minimum), the labels as R8 or R16 and each
+cut field's brick atlas (whole quanta) as R16 (value + 32768); the shader
+turns each texel back into the float the CPU holds. So the image must
 be the one R32F textures give (NormalizedTexturesOff), pixel for pixel, and
 the CPU path's image within the mapper tests' tolerance; any other CT stays
 R32F. Rendered with whatever OpenGL VTK gives offscreen (Mesa llvmpipe here).
@@ -51,11 +52,14 @@ def image_of(values, dtype=None):
     return image
 
 
-def cut_view(scene, ct, iso, program_cache, labels=None, width=WIDTH):
-    """A window showing the cut cube of ``ct`` (vtkImageData) at ``iso``, segments 1 and 2 of ``labels`` if given."""
+def cut_view(scene, ct, iso, program_cache, labels=None, width=WIDTH, cut=None):
+    """A window showing the cube of ``ct`` (vtkImageData) at ``iso``, cut by ``cut`` (default: the scene's cut).
+
+    Segments 1 and 2 of ``labels`` are shown if given.
+    """
     window, renderer = render_window(width)
     renderer.SetActiveCamera(A.make_camera(scene, 1.5, width, width))
-    mapper, _ = add_cut_volume(scene, ct, scene.cut_field(1), renderer)
+    mapper, _ = add_cut_volume(scene, ct, cut or scene.cut_field(1), renderer)
     caster = mapper.GetRayCaster()
     caster.SetIsoValue(iso)
     if labels is not None:
@@ -119,9 +123,11 @@ def test_an_integer_ct_travels_as_16_bits_and_draws_what_floats_draw(scene, prog
     window, mapper = cut_view(scene, image_of(values, dtype), iso, program_cache)
     (unorm, unorm_bytes, unorm_features, unorm_memory), (floats, float_bytes, float_features, float_memory) = both_formats(
         window, mapper)
-    assert unorm_bytes == 2 and unorm_features.endswith(" ct16")
-    assert float_bytes == 4 and "ct16" not in float_features
-    assert float_memory - unorm_memory == 2 * scene.dimensions**3
+    assert unorm_bytes == 2 and unorm_features.endswith(" ct16 cut16")
+    assert float_bytes == 4 and "ct16" not in float_features and "cut16" not in float_features
+    # Two bytes a voxel of the CT, two a texel of the cut field's atlas.
+    atlas_texels = mapper.GetOpenGLRayCaster().GetCutAtlasTextureSize()
+    assert float_memory - unorm_memory == 2 * scene.dimensions**3 + 2 * atlas_texels
     assert_same_image(floats, unorm)
     assert_like_cpu(window, mapper, unorm)
 
@@ -140,7 +146,7 @@ def test_the_16_bit_ct_composites_what_floats_composite(scene, program_cache):
     volume.GetProperty().SetScalarOpacity(opacity)
     mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
     (unorm, unorm_bytes, unorm_features, _), (floats, float_bytes, _, _) = both_formats(window, mapper)
-    assert (unorm_bytes, float_bytes) == (2, 4) and unorm_features == "cuts=1 composite ct16"
+    assert (unorm_bytes, float_bytes) == (2, 4) and unorm_features == "cuts=1 composite ct16 cut16"
     assert np.any(unorm[1][..., 3] > 0)
     assert_same_image(floats, unorm)
 
@@ -175,7 +181,7 @@ def test_labels_travel_as_8_or_16_bits(scene, program_cache, largest, bytes_per_
     gpu.NormalizedTexturesOff()
     floats = draw(window, mapper, GPU)
     assert gpu.GetLabelTextureBytesPerVoxel() == 4
-    assert gpu.GetTextureMemorySize() - memory == (2 + 4 - bytes_per_voxel) * n**3
+    assert gpu.GetTextureMemorySize() - memory == (2 + 4 - bytes_per_voxel) * n**3 + 2 * gpu.GetCutAtlasTextureSize()
     assert_same_image(floats, unorm)
     # Both segments are in the picture (the core through the cut).
     colors = unorm[1][unorm[1][..., 3] > 0]
@@ -240,7 +246,7 @@ def test_fractions_travel_as_16_bits_within_the_stated_tolerance(scene, program_
     gpu.NormalizedTexturesOff()
     floats = draw(window, mapper, GPU)
     assert gpu.GetFractionTextureBytesPerVoxel() == 16
-    assert gpu.GetTextureMemorySize() - memory == (2 + (3 if with_label_map else 0) + 8) * n**3
+    assert gpu.GetTextureMemorySize() - memory == (2 + (3 if with_label_map else 0) + 8) * n**3 + 2 * gpu.GetCutAtlasTextureSize()
     gpu.NormalizedTexturesOn()
     assert np.any(unorm[0] < 1.0)
     assert np.array_equal(unorm[0] < 1.0, floats[0] < 1.0)
@@ -249,3 +255,42 @@ def test_fractions_travel_as_16_bits_within_the_stated_tolerance(scene, program_
     print("RGBA16 against RGBA32F fractions: depth differs by at most", np.max(np.abs(unorm[0] - floats[0])),
           "on", np.count_nonzero(unorm[0] != floats[0]), "pixels; colour by at most", np.max(np.abs(unorm[1] - floats[1])))
     assert_like_cpu(window, mapper, draw(window, mapper, GPU))
+
+
+def test_a_cut_fields_atlas_travels_as_16_bits_exactly_before_and_after_a_stroke(scene, program_cache):
+    """A fractional CT stays float, so the memory saved is the atlas's alone: two bytes a texel."""
+    values, iso = cube_values(scene, 1.5, -1024.0)
+    n = scene.dimensions
+    fractional = values + 0.1 * (np.arange(n**3).reshape(n, n, n) % 7)
+    cut = scene.cut_field(1)
+    window, mapper = cut_view(scene, image_of(fractional, np.float32), iso, program_cache, cut=cut)
+    gpu = mapper.GetOpenGLRayCaster()
+    for stroke in range(2):
+        (unorm, unorm_features, unorm_memory, unorm_atlas), (floats, float_features, float_memory, float_atlas) = [
+            (draw(window, mapper, GPU), gpu.GetProgramFeatures(), gpu.GetTextureMemorySize(), gpu.GetCutAtlasTextureBytesPerVoxel())
+            for normalized in (True, False) if gpu.SetNormalizedTextures(normalized) is None
+        ]
+        gpu.NormalizedTexturesOn()
+        assert (unorm_atlas, float_atlas) == (2, 4)
+        assert unorm_features == "cuts=1 iso cut16" and float_features == "cuts=1 iso"
+        assert gpu.GetCutAtlasTextureSize() > 0 and float_memory - unorm_memory == 2 * gpu.GetCutAtlasTextureSize()
+        assert_same_image(floats, unorm)
+        assert_like_cpu(window, mapper, unorm)
+        # A burr stroke through the visible top face: only its bricks travel, as shorts.
+        top = scene.center + np.array([0.1, -0.1, 1.0]) * scene.half_size
+        cut.CutCapsule(list(top), list(top + [0.5, 0.3, -0.4]), 0.8)
+
+
+def test_the_cut_atlas_draws_the_cut_the_cpu_draws_at_every_stored_distance(scene, program_cache):
+    """Distances of every sign and size the field stores: a mismatch anywhere moves the cut surface."""
+    values, iso = cube_values(scene, 1.5, -1024.0)
+    cut = scene.cut_field(1)
+    window, mapper = cut_view(scene, image_of(values, np.int16), iso, program_cache, cut=cut)
+    gpu = mapper.GetOpenGLRayCaster()
+    rng = np.random.default_rng(7)
+    for _ in range(6):
+        start = scene.center + rng.uniform(-1.0, 1.0, 3) * scene.half_size
+        cut.CutCapsule(list(start), list(start + rng.uniform(-1.0, 1.0, 3)), rng.uniform(0.3, 1.2))
+    drawn = draw(window, mapper, GPU)
+    assert gpu.GetCutAtlasTextureBytesPerVoxel() == 2
+    assert_like_cpu(window, mapper, drawn)
