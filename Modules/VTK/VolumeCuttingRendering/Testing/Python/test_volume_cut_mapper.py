@@ -944,3 +944,47 @@ def test_composite_opacity_is_corrected_for_the_thickness_on_both_paths():
             assert np.all(np.abs(row[:, 3] - 255.0 * alpha) <= 1.5)
             assert np.all(np.abs(row[:, 0] - 255.0 * alpha) <= 1.5)
             assert np.all(np.abs(row[:, 1] - green) <= 1.5)
+
+
+@pytest.mark.parametrize("spacing_in", ["image", "volume matrix"])
+def test_composite_opacity_is_per_millimetre_wherever_the_spacing_is_stored(spacing_in):
+    """A uniform slab 4 voxels of 0.5 mm (2 mm) thick, opacity 0.5 per mm: alpha 0.75 on both paths.
+
+    Slicer puts a volume's spacing in the vtkVolume's matrix; VTK's stock GPU
+    mapper counts the unit distance in voxels there (alpha 1 - 0.5**4 =
+    0.9375 for this slab), which made it look brighter than this mapper.
+    """
+    n, slab, spacing, width = 16, 4, 0.5, 32
+    values = np.full((slab + 1, n, n), 1000.0, np.float32)
+    image = vtk.vtkImageData()
+    image.SetDimensions(n, n, slab + 1)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.ravel(), deep=True))
+    volume = vtk.vtkVolume()
+    if spacing_in == "image":
+        image.SetSpacing(spacing, spacing, spacing)
+    else:
+        matrix = vtk.vtkMatrix4x4()
+        for axis in range(3):
+            matrix.SetElement(axis, axis, spacing)
+        volume.SetUserMatrix(matrix)
+    window, renderer = render_window(width)
+    camera = renderer.GetActiveCamera()
+    camera.ParallelProjectionOn()
+    centre = 7.5 * spacing
+    camera.SetFocalPoint(centre, centre, 0.0)
+    camera.SetPosition(centre, centre, 50.0)
+    camera.SetParallelScale(2.0 * spacing)
+    camera.SetClippingRange(1.0, 100.0)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(image)
+    mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
+    mapper.GetRayCaster().SetAmbient(1.0)
+    mapper.GetRayCaster().SetDiffuse(0.0)
+    mapper.GetRayCaster().SetSpecular(0.0)
+    volume.SetMapper(mapper)
+    renderer.AddVolume(volume)
+    set_transfer_functions(volume, [(0.0, 1.0, 1.0, 1.0), (2000.0, 1.0, 1.0, 1.0)], [(0.0, 0.5), (2000.0, 0.5)])
+    alpha = 1.0 - 0.5 ** (slab * spacing)
+    for _, (_, drawn) in render_on_both_paths(window, mapper, width).items():
+        centre_pixels = drawn[width // 4 : 3 * width // 4, width // 4 : 3 * width // 4]
+        assert np.all(np.abs(centre_pixels[..., 3] - 255.0 * alpha) <= 1.5)
