@@ -907,6 +907,26 @@ def test_gpu_and_cpu_paths_composite_the_same_image():
     assert difference.max() <= 12
 
 
+def slab_view(image, volume, width, centre, half_height):
+    """``image`` composited unshaded by ``volume`` in a parallel view down z, centred on (centre, centre)."""
+    window, renderer = render_window(width)
+    camera = renderer.GetActiveCamera()
+    camera.ParallelProjectionOn()
+    camera.SetFocalPoint(centre, centre, 0.0)
+    camera.SetPosition(centre, centre, 50.0)
+    camera.SetParallelScale(half_height)
+    camera.SetClippingRange(1.0, 100.0)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(image)
+    mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
+    mapper.GetRayCaster().SetAmbient(1.0)
+    mapper.GetRayCaster().SetDiffuse(0.0)
+    mapper.GetRayCaster().SetSpecular(0.0)
+    volume.SetMapper(mapper)
+    renderer.AddVolume(volume)
+    return window, mapper, volume
+
+
 def test_composite_opacity_is_corrected_for_the_thickness_on_both_paths():
     """A uniform slab 1 mm and 3 mm thick, opacity 0.5 per mm: alpha is 1 - 0.5**thickness, colour the transfer function's."""
     n = 16
@@ -919,22 +939,7 @@ def test_composite_opacity_is_corrected_for_the_thickness_on_both_paths():
         image = vtk.vtkImageData()
         image.SetDimensions(n, n, thickness + 1)
         image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.ravel(), deep=True))
-        window, renderer = render_window(width)
-        camera = renderer.GetActiveCamera()
-        camera.ParallelProjectionOn()
-        camera.SetFocalPoint(7.5, 7.5, 0.0)
-        camera.SetPosition(7.5, 7.5, 50.0)
-        camera.SetParallelScale(4.0)
-        camera.SetClippingRange(1.0, 100.0)
-        mapper = vc.vtkVolumeCutVolumeMapper()
-        mapper.SetInputData(image)
-        mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
-        mapper.GetRayCaster().SetAmbient(1.0)
-        mapper.GetRayCaster().SetDiffuse(0.0)
-        mapper.GetRayCaster().SetSpecular(0.0)
-        volume = vtk.vtkVolume()
-        volume.SetMapper(mapper)
-        renderer.AddVolume(volume)
+        window, mapper, volume = slab_view(image, vtk.vtkVolume(), width, 7.5, 4.0)
         set_transfer_functions(volume, [(1000.0, 1.0, 1.0, 1.0), (1150.0, 1.0, 0.0, 0.0)], [(1000.0, 0.5), (1150.0, 0.5)])
         alpha = 1.0 - 0.5**thickness
         x = 7.5 + (np.arange(width) + 0.5 - width / 2) * 0.25
@@ -967,22 +972,7 @@ def test_composite_opacity_is_per_millimetre_wherever_the_spacing_is_stored(spac
         for axis in range(3):
             matrix.SetElement(axis, axis, spacing)
         volume.SetUserMatrix(matrix)
-    window, renderer = render_window(width)
-    camera = renderer.GetActiveCamera()
-    camera.ParallelProjectionOn()
-    centre = 7.5 * spacing
-    camera.SetFocalPoint(centre, centre, 0.0)
-    camera.SetPosition(centre, centre, 50.0)
-    camera.SetParallelScale(2.0 * spacing)
-    camera.SetClippingRange(1.0, 100.0)
-    mapper = vc.vtkVolumeCutVolumeMapper()
-    mapper.SetInputData(image)
-    mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
-    mapper.GetRayCaster().SetAmbient(1.0)
-    mapper.GetRayCaster().SetDiffuse(0.0)
-    mapper.GetRayCaster().SetSpecular(0.0)
-    volume.SetMapper(mapper)
-    renderer.AddVolume(volume)
+    window, mapper, volume = slab_view(image, volume, width, 7.5 * spacing, 2.0 * spacing)
     set_transfer_functions(volume, [(0.0, 1.0, 1.0, 1.0), (2000.0, 1.0, 1.0, 1.0)], [(0.0, 0.5), (2000.0, 0.5)])
     alpha = 1.0 - 0.5 ** (slab * spacing)
     for _, (_, drawn) in render_on_both_paths(window, mapper, width).items():
