@@ -30,6 +30,18 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   {
     defines += "#define ANATOMY_UNORM16\n";
   }
+  if (features.AnatomyFiltered)
+  {
+    defines += "#define ANATOMY_FILTERED\n";
+  }
+  if (features.FractionsFiltered)
+  {
+    defines += "#define FRACTIONS_FILTERED\n";
+  }
+  if (features.FilterWeightBits > 0)
+  {
+    defines += "#define FILTER_WEIGHT_STEPS " + std::to_string(1 << std::min(features.FilterWeightBits, 16)) + ".0\n";
+  }
   vtkShaderProgram::Substitute(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
   vtkShaderProgram::Substitute(source, "//VolumeCut::Classification::Dec", vtkVolumeCutClassificationFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
@@ -103,5 +115,8 @@ std::string vtkVolumeCutShaderComposer::Describe(const Features& features)
   text += features.AmbientOcclusion ? " occlusion" : "";
   text += features.ClipPlanes > 0 ? " planes=" + std::to_string(features.ClipPlanes) : "";
   text += features.AnatomyUnorm16 ? " ct16" : "";
+  text += features.AnatomyFiltered ? " ct-filtered" : "";
+  text += features.FractionsFiltered ? " fractions-filtered" : "";
+  text += features.FilterWeightBits > 0 ? " weights=" + std::to_string(features.FilterWeightBits) : "";
   return text;
 }
