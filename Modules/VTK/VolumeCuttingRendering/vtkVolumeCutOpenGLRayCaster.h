@@ -238,7 +238,7 @@ public:
    * interpolates about as finely as the 16-bit texels resolve (Mesa's
    * llvmpipe: float weights, 1e-7) and keeps the texel-by-texel path on GPUs
    * with 8-bit weights (2^-9): there a surface moves by up to 0.0034 voxel,
-   * more than the CPU/GPU depth tolerance in close-ups (README, rendering).
+   * more than the CPU/GPU depth tolerance in close-ups (Docs/Architecture.md).
    * 2^-9 or more lets such GPUs filter.
    */
   vtkSetClampMacro(MaximumFilterWeightError, double, 0.0, 1.0);
