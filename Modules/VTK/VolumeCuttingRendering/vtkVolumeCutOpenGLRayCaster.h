@@ -214,11 +214,14 @@ public:
    * CPU's trilinear value at a point moved by at most 2^-9 voxel along each
    * axis: an iso-surface moves by at most sqrt(3) 2^-9 = 0.0034 voxel
    * whatever the CT's contrast (0.03 pixel at 8 pixels a voxel, far inside
-   * the mapper tests' half-pixel edges), and a normal's central difference
-   * over a gradient step h (voxels) changes by at most 2^-9 / h of the
-   * gradient. Measured with EmulatedFilterWeightBits 8: colour within the
-   * CPU/GPU tolerance (2/255 on 99.5 % of the pixels), a sphere's depth RMS
-   * unchanged (0.0194 voxel), but the depth differs from the CPU's by more
+   * the mapper tests' half-pixel edges), and each sample of a normal's
+   * central differences (GradientStep h voxels each way) by at most the
+   * gradient's length times sqrt(3) 2^-9: the normal turns by at most
+   * 3 2^-9 / h radians (0.34 degrees at h = 1), its diffuse shade by at most
+   * 1.5/255. Measured with EmulatedFilterWeightBits 8: colour within the
+   * CPU/GPU tolerance (2/255 on 99.5 % of the pixels), a sphere's error
+   * unchanged (radial RMS 0.0194 voxel, depth RMS 0.0246), but the depth
+   * differs from the CPU's by more
    * than 1e-4 of the window range on 38 % of the pixels of a close-up (8
    * pixels a voxel) and at silhouettes; hence MaximumFilterWeightError.
    * A float-weight unit (Mesa's llvmpipe) gives the exact path's image.
