@@ -131,6 +131,23 @@ void main()
 }
 )GLSL";
 
+// Samples a 2-texel R16 texture (0 and 65535) with GL_LINEAR at a row of
+// points between the texel centres: what the texture unit returns against
+// the exact lerp tells how finely it weights texels.
+const char* const FilterProbeFragmentShader = R"GLSL(//VTK::System::Dec
+//VTK::Output::Dec
+in vec2 texCoord;
+uniform sampler3D probeTexture;
+uniform float pointCount;
+void main()
+{
+  // Pixel k (texCoord (k + 0.5) / pointCount) samples (k + 0.37) / pointCount:
+  // points off any grid of 2^-n steps.
+  float x = (floor(texCoord.x * pointCount) + 0.37) / pointCount;
+  gl_FragData[0] = vec4(textureLod(probeTexture, vec3(0.5 * (x + 0.5), 0.5, 0.5), 0.0).r, 0.0, 0.0, 1.0);
+}
+)GLSL";
+
 // The last image cast, and what it was cast from: a frame from the same
 // state but cut fields recasts only where their modified bricks project.
 struct KeptImage
@@ -179,9 +196,12 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   // format and the values that turn texels back into CT values and labels.
   bool TexturesNormalized = false;
   bool AnatomyUnorm16 = false;
+  bool FractionsUnorm16 = false;
   float AnatomyMinimum = 0.f;
   float LabelScale = 1.f;
   vtkMTimeType SceneVersion = 0;
+  // The texture unit's interpolation error in this context (-1: not measured yet).
+  double FilterWeightError = -1.0;
   // The program for the features of the last Render, and the quad it draws.
   vtkVolumeCutProgramBuilder Builder;
   std::string BuiltFeatures;
@@ -243,6 +263,8 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     this->LabelVersion = 0;
     this->SceneVersion = 0;
     this->AnatomyUnorm16 = false;
+    this->FractionsUnorm16 = false;
+    this->FilterWeightError = -1.0;
     this->Context = nullptr;
   }
 
@@ -406,6 +428,15 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     return texture;
   }
 
+  // Texel fetches ignore the filter, so one texture serves both the
+  // texture unit's interpolation and the shader's exact per-texel reads.
+  static void SetLinearFiltering(vtkTextureObject* texture, bool linear)
+  {
+    const int filter = linear ? vtkTextureObject::Linear : vtkTextureObject::Nearest;
+    texture->SetMinificationFilter(filter);
+    texture->SetMagnificationFilter(filter);
+  }
+
   // Bytes per voxel of the first component of a 3D texture as the driver
   // stores it (0 where the driver made none, e.g. a format it does not offer).
   static int BytesPerVoxel(vtkTextureObject* texture)
@@ -430,6 +461,78 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       return nullptr;
     }
     return texture;
+  }
+
+  // The largest difference between the texture unit's linear interpolation
+  // of two R16 texels, 0 and 65535, and the exact lerp, over 1021 points
+  // between them (a fraction of the texels' difference: 2^-9 for weights
+  // rounded to 8 bits, about 1e-7 for float weights); -1 where the driver
+  // cannot filter R16 or draw into a float target.
+  double MeasureFilterWeightError(vtkOpenGLRenderWindow* window)
+  {
+    constexpr int points = 1021;
+    const unsigned short texels[2] = { 0, 65535 };
+    vtkSmartPointer<vtkTextureObject> probe = Texture3D(window, 2, 1, 1, 1, VTK_UNSIGNED_SHORT, GL_R16, texels);
+    if (!probe)
+    {
+      return -1.0;
+    }
+    SetLinearFiltering(probe, true);
+    auto target = vtkSmartPointer<vtkTextureObject>::New();
+    target->SetContext(window);
+    target->SetMinificationFilter(vtkTextureObject::Nearest);
+    target->SetMagnificationFilter(vtkTextureObject::Nearest);
+    double error = -1.0;
+    if (BytesPerVoxel(probe) == 2 && target->Allocate2D(points, 1, 1, VTK_FLOAT))
+    {
+      vtkNew<vtkOpenGLFramebufferObject> framebuffer;
+      framebuffer->SetContext(window);
+      vtkOpenGLState* state = window->GetState();
+      state->PushFramebufferBindings();
+      framebuffer->Bind();
+      framebuffer->AddColorAttachment(0, target);
+      framebuffer->ActivateDrawBuffers(1);
+      framebuffer->ActivateReadBuffer(0);
+      const char* description = nullptr;
+      vtkOpenGLQuadHelper quad(window, vtkOpenGLRenderUtilities::GetFullScreenQuadVertexShader().c_str(), FilterProbeFragmentShader, "");
+      if (vtkOpenGLFramebufferObject::GetFrameBufferStatus(vtkOpenGLFramebufferObject::GetDrawMode(), description) && quad.Program &&
+        quad.Program->GetCompiled())
+      {
+        std::vector<float> values(points, -1.f);
+        {
+          vtkOpenGLState::ScopedglViewport viewport(state);
+          vtkOpenGLState::ScopedglEnableDisable scissorTest(state, GL_SCISSOR_TEST);
+          vtkOpenGLState::ScopedglEnableDisable blend(state, GL_BLEND);
+          vtkOpenGLState::ScopedglEnableDisable depthTest(state, GL_DEPTH_TEST);
+          vtkOpenGLState::ScopedglColorMask colorMask(state);
+          state->vtkglViewport(0, 0, points, 1);
+          state->vtkglDisable(GL_SCISSOR_TEST);
+          state->vtkglDisable(GL_BLEND);
+          state->vtkglDisable(GL_DEPTH_TEST);
+          state->vtkglColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+          window->GetShaderCache()->ReadyShaderProgram(quad.Program);
+          probe->Activate();
+          quad.Program->SetUniformi("probeTexture", probe->GetTextureUnit());
+          quad.Program->SetUniformf("pointCount", static_cast<float>(points));
+          quad.Render();
+          probe->Deactivate();
+          glPixelStorei(GL_PACK_ALIGNMENT, 4);
+          glReadPixels(0, 0, points, 1, GL_RED, GL_FLOAT, values.data());
+        }
+        error = 0.0;
+        for (int k = 0; k < points && error >= 0.0; ++k)
+        {
+          const double x = (k + 0.37) / points;
+          error = values[k] >= 0.f ? std::max(error, std::abs(values[k] - x)) : -1.0;
+        }
+      }
+      quad.ReleaseGraphicsResources(window);
+      framebuffer->ReleaseGraphicsResources(window);
+      state->PopFramebufferBindings();
+    }
+    probe->ReleaseGraphicsResources(window);
+    target->ReleaseGraphicsResources(window);
+    return error;
   }
 
   // Bring one cut field's page table and atlas up to date; returns the
@@ -872,6 +975,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     // holds them in 0..1 (each within 1/131070 of its value, far inside the
     // CPU/GPU tolerance of the mapper tests), else RGBA32F.
     impl.Fractions = nullptr;
+    impl.FractionsUnorm16 = false;
     if (!view.Fractions.empty() && this->NormalizedTextures)
     {
       std::vector<unsigned short> quantized(4 * voxels, 0);
@@ -889,6 +993,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
         impl.Fractions->ReleaseGraphicsResources(window);
         impl.Fractions = nullptr;
       }
+      impl.FractionsUnorm16 = impl.Fractions != nullptr;
     }
     if (!impl.Fractions)
     {
@@ -1014,6 +1119,22 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     features.CutAtlasUnorm16.push_back(impl.Cuts[n].Unorm16);
   }
   this->CutAtlasTextureBytesPerVoxel = cuts > 0 ? impl.Cuts[0].AtlasBytesPerTexel : 0;
+  // Only 16-bit normalized textures are filtered (R32F is not filterable
+  // everywhere: OES_texture_float_linear; labels are never interpolated),
+  // and only by a texture unit that weights texels finely enough.
+  if (this->HardwareFiltering && impl.FilterWeightError < 0.0 && (impl.AnatomyUnorm16 || impl.FractionsUnorm16))
+  {
+    impl.FilterWeightError = impl.MeasureFilterWeightError(window);
+  }
+  this->FilterWeightError = impl.FilterWeightError;
+  const bool precise = this->HardwareFiltering && impl.FilterWeightError >= 0.0 && impl.FilterWeightError <= this->MaximumFilterWeightError;
+  this->AnatomyHardwareFiltered = precise && impl.AnatomyUnorm16;
+  this->FractionsHardwareFiltered = precise && impl.FractionsUnorm16;
+  Internals::SetLinearFiltering(impl.Anatomy, this->AnatomyHardwareFiltered);
+  Internals::SetLinearFiltering(impl.Fractions, this->FractionsHardwareFiltered);
+  features.AnatomyFiltered = this->AnatomyHardwareFiltered;
+  features.FractionsFiltered = this->FractionsHardwareFiltered;
+  features.FilterWeightBits = this->EmulatedFilterWeightBits;
   if (!impl.ReadyProgram(this, window, features))
   {
     return false;
@@ -1284,6 +1405,10 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LabelTextureBytesPerVoxel: " << this->LabelTextureBytesPerVoxel << "\n";
   os << indent << "FractionTextureBytesPerVoxel: " << this->FractionTextureBytesPerVoxel << "\n";
   os << indent << "CutAtlasTextureBytesPerVoxel: " << this->CutAtlasTextureBytesPerVoxel << "\n";
+  os << indent << "HardwareFiltering: " << this->HardwareFiltering << " (CT " << this->AnatomyHardwareFiltered << ", fractions "
+     << this->FractionsHardwareFiltered << ")\n";
+  os << indent << "MaximumFilterWeightError: " << this->MaximumFilterWeightError << " (measured " << this->FilterWeightError << ")\n";
+  os << indent << "EmulatedFilterWeightBits: " << this->EmulatedFilterWeightBits << "\n";
   os << indent << "LocalizedUpdates: " << this->LocalizedUpdates << "\n";
   os << indent << "NumberOfPixelsRecast: " << this->NumberOfPixelsRecast << (this->LastRenderWasLocalized ? " (localized)" : "")
      << ", region " << this->UpdatedRegion[0] << " " << this->UpdatedRegion[1] << " " << this->UpdatedRegion[2] << " "

@@ -6,8 +6,10 @@
  *
  * Draws one full-viewport quad whose fragment shader casts the pixel's ray
  * through the scene prepared by a vtkVolumeCutRayCaster: the CT and labels as
- * 3D textures fetched texel by texel (the same trilinear arithmetic as the
- * CPU; 16-bit or 8-bit where lossless, see NormalizedTextures), each cut field as a page table (one texel a brick) and an atlas of
+ * 3D textures (16-bit or 8-bit where lossless, see NormalizedTextures), the
+ * labels fetched texel by texel, the CT and fractions filtered by the
+ * texture unit where 16-bit (see HardwareFiltering), by the CPU's trilinear
+ * arithmetic otherwise; each cut field as a page table (one texel a brick) and an atlas of
  * 8^3 bricks in which only bricks modified since the last frame are
  * re-uploaded (vtkVolumeCutField's modification stamps). It writes colour
  * (premultiplied) and the depth of the first visible surface.
@@ -199,6 +201,88 @@ public:
 
   ///@{
   /**
+   * Set/get whether the texture unit interpolates the CT and the fractions
+   * (GL_LINEAR, one filtered fetch at the cell-centred coordinate
+   * (index + 0.5) / dimensions) instead of the shader (eight texel fetches
+   * and seven lerps in float). Used only where those textures are 16-bit
+   * normalized: the CT as R16 (see NormalizedTextures), fractions as RGBA16;
+   * a CT kept as R32F and the labels are always fetched texel by texel.
+   *
+   * Accuracy: texture units weight texels with fixed-point fractions,
+   * commonly of 8 bits (Direct3D's sub-texel precision; NVIDIA's CUDA guide
+   * gives 9-bit weights with 8 fraction bits, rounded to the nearest 1/256;
+   * Vulkan reports it as subTexelPrecisionBits), so the filtered value is the
+   * CPU's trilinear value at a point moved by at most 2^-9 voxel along each
+   * axis: an iso-surface moves by at most sqrt(3) 2^-9 = 0.0034 voxel
+   * whatever the CT's contrast (0.03 pixel at 8 pixels a voxel, far inside
+   * the mapper tests' half-pixel edges), and each sample of a normal's
+   * central differences (GradientStep h voxels each way) by at most the
+   * gradient's length times sqrt(3) 2^-9: the normal turns by at most
+   * 3 2^-9 / h radians (0.34 degrees at h = 1), its diffuse shade by at most
+   * 1.5/255. Measured with EmulatedFilterWeightBits 8: colour within the
+   * CPU/GPU tolerance (2/255 on 99.5 % of the pixels), a sphere's error
+   * unchanged (radial RMS 0.0194 voxel, depth RMS 0.0246), but the depth
+   * differs from the CPU's by more
+   * than 1e-4 of the window range on 38 % of the pixels of a close-up (8
+   * pixels a voxel) and at silhouettes; hence MaximumFilterWeightError.
+   * A float-weight unit (Mesa's llvmpipe) gives the exact path's image.
+   * Default is true; a change takes effect at the next Render.
+   */
+  vtkSetMacro(HardwareFiltering, bool);
+  vtkGetMacro(HardwareFiltering, bool);
+  vtkBooleanMacro(HardwareFiltering, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the largest interpolation error of the texture unit, as a
+   * fraction of the difference between two texels, at which
+   * HardwareFiltering is used. The first Render in a context measures it
+   * (GetFilterWeightError). The default, 2^-16, filters where the unit
+   * interpolates about as finely as the 16-bit texels resolve (Mesa's
+   * llvmpipe: float weights, 1e-7) and keeps the texel-by-texel path on GPUs
+   * with 8-bit weights (2^-9): there a surface moves by up to 0.0034 voxel,
+   * more than the CPU/GPU depth tolerance in close-ups (Docs/Architecture.md).
+   * 2^-9 or more lets such GPUs filter.
+   */
+  vtkSetClampMacro(MaximumFilterWeightError, double, 0.0, 1.0);
+  vtkGetMacro(MaximumFilterWeightError, double);
+  ///@}
+
+  /**
+   * The texture unit's interpolation error measured in the last Render's
+   * context: the largest difference, over 1021 points, between GL_LINEAR
+   * between two R16 texels 0 and 65535 and the exact lerp, a fraction of
+   * their difference. -1 before it was measured, or where the driver cannot
+   * filter R16 (the CT and fractions are then fetched texel by texel).
+   */
+  vtkGetMacro(FilterWeightError, double);
+
+  ///@{
+  /**
+   * Whether the last Render's program sampled the CT, or the fractions,
+   * with the texture unit's filtering (HardwareFiltering on, the texture
+   * 16-bit normalized, and the unit's FilterWeightError within
+   * MaximumFilterWeightError); false before the first Render.
+   */
+  vtkGetMacro(AnatomyHardwareFiltered, bool);
+  vtkGetMacro(FractionsHardwareFiltered, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get, for accuracy tests, the fractional bits to which the shader's
+   * own trilinear interpolation of the CT and the fractions rounds its
+   * weights (0, the default: float weights). 8 gives, on any driver, what
+   * a texture unit with 8-bit weights would filter; it applies where
+   * HardwareFiltering is not in use (turn that off to see it).
+   */
+  vtkSetClampMacro(EmulatedFilterWeightBits, int, 0, 16);
+  vtkGetMacro(EmulatedFilterWeightBits, int);
+  ///@}
+
+  ///@{
+  /**
    * Bytes a voxel of the CT texture, the label texture and the fractions'
    * texture take on the GPU, as the driver reports them for the last upload
    * (GL_TEXTURE_RED_SIZE): 2 for R16, 4 for R32F, 1 for R8, 8 for RGBA16,
@@ -252,6 +336,12 @@ protected:
   int LabelTextureBytesPerVoxel = 0;
   int FractionTextureBytesPerVoxel = 0;
   int CutAtlasTextureBytesPerVoxel = 0;
+  bool HardwareFiltering = true;
+  bool AnatomyHardwareFiltered = false;
+  bool FractionsHardwareFiltered = false;
+  int EmulatedFilterWeightBits = 0;
+  double MaximumFilterWeightError = 1.0 / 65536.0;
+  double FilterWeightError = -1.0;
   bool LocalizedUpdates = true;
   bool LastRenderWasLocalized = false;
   vtkIdType NumberOfPixelsRecast = 0;

@@ -37,6 +37,18 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
       defines += "#define CUT_ATLAS_UNORM16_" + std::to_string(n) + "\n";
     }
   }
+  if (features.AnatomyFiltered)
+  {
+    defines += "#define ANATOMY_FILTERED\n";
+  }
+  if (features.FractionsFiltered)
+  {
+    defines += "#define FRACTIONS_FILTERED\n";
+  }
+  if (features.FilterWeightBits > 0)
+  {
+    defines += "#define FILTER_WEIGHT_STEPS " + std::to_string(1 << std::min(features.FilterWeightBits, 16)) + ".0\n";
+  }
   vtkShaderProgram::Substitute(source, "//VTK::Output::Dec", "//VTK::Output::Dec\n" + defines);
   vtkShaderProgram::Substitute(source, "//VolumeCut::Classification::Dec", vtkVolumeCutClassificationFS);
   vtkShaderProgram::Substitute(source, "//VolumeCut::CutFields::Dec", vtkVolumeCutCutFieldsFS);
@@ -112,5 +124,8 @@ std::string vtkVolumeCutShaderComposer::Describe(const Features& features)
   text += features.AnatomyUnorm16 ? " ct16" : "";
   const bool anyCut16 = std::find(features.CutAtlasUnorm16.begin(), features.CutAtlasUnorm16.end(), true) != features.CutAtlasUnorm16.end();
   text += anyCut16 ? " cut16" : "";
+  text += features.AnatomyFiltered ? " ct-filtered" : "";
+  text += features.FractionsFiltered ? " fractions-filtered" : "";
+  text += features.FilterWeightBits > 0 ? " weights=" + std::to_string(features.FilterWeightBits) : "";
   return text;
 }

@@ -51,11 +51,17 @@ public:
     bool AnatomyUnorm16 = false;
     /// Per cut field: its atlas is R16 (distance + 32768), not R32F.
     std::vector<bool> CutAtlasUnorm16;
+    /// The texture unit interpolates the CT (GL_LINEAR R16), not the shader.
+    bool AnatomyFiltered = false;
+    /// The texture unit interpolates the fractions (GL_LINEAR RGBA16).
+    bool FractionsFiltered = false;
+    /// Fractional bits of the shader's own interpolation weights (0: float; tests only).
+    int FilterWeightBits = 0;
     /// GLSL added before main() (empty unless the caster was given some).
     std::string ExtraDeclarations;
   };
 
-  /// A short description of the features ("cuts=2 labels fractions=1 iso ... ct16").
+  /// A short description of the features ("cuts=2 labels fractions=1 iso ... ct16 ct-filtered").
   static std::string Describe(const Features& features);
 
   /// The complete fragment shader for these features.

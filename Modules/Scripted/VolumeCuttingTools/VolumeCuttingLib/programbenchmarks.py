@@ -3,8 +3,12 @@
 It also compares the CT and label textures as R32F (NormalizedTextures off,
 as before 16-bit textures) with R16/R8 (on) on the head CT and the
 patient-scale case: texture memory, and the GPU path's frame time with each,
-frames alternating in one process. On llvmpipe the frame time is a proxy
-only: a CPU rasterizer has no texture cache or memory bandwidth of a GPU's.
+frames alternating in one process; and, the same way, the R16 CT interpolated
+by the texture unit (HardwareFiltering on) against the shader's eight texel
+fetches (off). On llvmpipe the frame time is a proxy only: a CPU rasterizer
+has no texture cache or memory bandwidth of a GPU's, and its filtering is
+code too, so the ratio says how much shader work filtering removes, not what
+a GPU gains.
 
 A start is a new process (as a new start of the application), rendering the
 analytic cut cube of ``analyticscene.py`` on the GPU path; its build time is
@@ -142,8 +146,9 @@ def _image(array_kji) -> vtk.vtkImageData:
     return image
 
 
-def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256) -> dict:
-    """GPU-path figures of one CT with its label map, textures R32F (off) and R16/R8 (on), frames alternating."""
+def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256, switch: str = "NormalizedTextures") -> dict:
+    """GPU-path figures of one CT with its label map, with the caster's ``switch`` off and on, frames alternating:
+    NormalizedTextures (textures R32F against R16/R8) or HardwareFiltering (the texture unit interpolating the R16 CT)."""
     import time
 
     import slicer_volumecutting as vc
@@ -176,6 +181,10 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256) -> dict
     mapper.SetProgramBuildTimeLimit(600.0)
     mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
     gpu = mapper.GetOpenGLRayCaster()
+    # Every frame casts the whole image: an unchanged frame would otherwise
+    # only draw the kept image again.
+    gpu.LocalizedUpdatesOff()
+    set_switch = getattr(gpu, "Set" + switch)
     figures = {normalized: {"frame_s": [], "frame_cpu_s": [], "upload_frame_s": []} for normalized in (False, True)}
 
     def frame():
@@ -189,11 +198,11 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256) -> dict
 
     # Both programs built before anything is timed.
     for normalized in (False, True):
-        gpu.SetNormalizedTextures(normalized)
+        set_switch(normalized)
         frame()
     for _ in range(repeats):
         for normalized in (False, True):
-            gpu.SetNormalizedTextures(normalized)
+            set_switch(normalized)
             figures[normalized]["upload_frame_s"].append(frame()[0])
             for _ in range(2):
                 wall, cpu = frame()
@@ -203,12 +212,15 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256) -> dict
             figures[normalized]["ct_bytes_per_voxel"] = gpu.GetAnatomyTextureBytesPerVoxel()
             figures[normalized]["label_bytes_per_voxel"] = gpu.GetLabelTextureBytesPerVoxel()
             figures[normalized]["features"] = gpu.GetProgramFeatures()
+            figures[normalized]["ct_filtered"] = bool(gpu.GetAnatomyHardwareFiltered())
     return {
+        "switch": switch,
+        "filter_weight_error": gpu.GetFilterWeightError(),
         "dimensions": [int(ct.shape[2]), int(ct.shape[1]), int(ct.shape[0])],
         "window": [width, width],
         "driver": gpu.GetDriverDescription(),
-        "float": figures[False],
-        "normalized": figures[True],
+        "off": figures[False],
+        "on": figures[True],
     }
 
 
@@ -228,7 +240,7 @@ def texture_formats(repeats: int) -> list[dict]:
         driver = figures["driver"]
         machine = machine_description(driver.split(", OpenGL")[0])
         size = " x ".join(str(d) for d in figures["dimensions"])
-        new, old = figures["normalized"], figures["float"]
+        new, old = figures["on"], figures["off"]
         memory = measurement(
             f"{name} ({size}) on the GPU path: texture memory, CT as R16 and labels as R8",
             new["texture_bytes"] / 2**20, "MiB", "the same with CT and labels as R32F (NormalizedTextures off)",
@@ -240,6 +252,33 @@ def texture_formats(repeats: int) -> list[dict]:
         for result in (memory, frame):
             result["details"] = figures
         results += [memory, frame]
+    return results
+
+
+def texture_filtering(repeats: int) -> list[dict]:
+    """GPU-path frame time on the head CT, its R16 CT interpolated by the texture unit against the shader's texel fetches."""
+    from . import headct
+
+    head, _, head_ijk_to_ras = headct.load_array()
+    load_before = os.getloadavg()
+    figures = _format_case(head, (head >= 300).astype(np.uint8), head_ijk_to_ras, repeats, switch="HardwareFiltering")
+    figures["load_average"] = {"before": [round(v, 2) for v in load_before], "after": [round(v, 2) for v in os.getloadavg()]}
+    if not figures["on"]["ct_filtered"]:
+        raise RuntimeError(f"gpuprogram benchmark: the CT was not filtered ({figures['normalized']['features']}, "
+                           f"interpolation error {figures['filter_weight_error']})")
+    driver = figures["driver"]
+    machine = machine_description(driver.split(", OpenGL")[0])
+    size = " x ".join(str(d) for d in figures["dimensions"])
+    results = []
+    for key, what in (("frame_s", "frame time"), ("frame_cpu_s", "processor time a frame")):
+        result = measurement(
+            f"head CT ({size}) on the GPU path: {what}, R16 CT interpolated by the texture unit ({driver.split(',')[0]}: "
+            "shader work removed, not GPU speed)",
+            statistics.median(figures["on"][key]), "s",
+            "the same frames with the shader's eight texel fetches a sample (HardwareFiltering off), alternating in the same process",
+            statistics.median(figures["off"][key]), repeats, machine)
+        result["details"] = figures
+        results.append(result)
     return results
 
 
@@ -288,4 +327,4 @@ def gpuprogram(repeats: int) -> list[dict]:
     ]
     for result in results:
         result["details"] = details
-    return results + texture_formats(repeats)
+    return results + texture_formats(repeats) + texture_filtering(repeats)

@@ -4,14 +4,14 @@
 // segment's object is there and the CT value (vtkVolumeCutSampleClassifier.h
 // documents it). Replaces the skeleton's VolumeCut::Classification::Dec tag.
 
-uniform sampler3D anatomyTexture;   // CT, fetched texel by texel: R32F, or R16 (ANATOMY_UNORM16)
+uniform sampler3D anatomyTexture;   // CT: R32F, or R16 (ANATOMY_UNORM16), GL_LINEAR if ANATOMY_FILTERED
 uniform float anatomyMinimum;       // R16: the CT value of texel 0
 uniform sampler3D labelTexture;     // labels, when hasLabels: R16 or R8, unsigned normalized
 uniform float labelScale;           // 65535 (R16) or 255 (R8)
 uniform sampler2D styleTexture;     // per label: (rgb, opacity), (iso, shape, 0, 0), (uncut surface rgb, 0)
 uniform int hasLabels;             // a label map or fractional labelmaps
 uniform int hasLabelMap;
-uniform sampler3D fractionTexture;  // up to 4 segments' fractions (RGBA)
+uniform sampler3D fractionTexture;  // up to 4 segments' fractions (RGBA), GL_LINEAR if FRACTIONS_FILTERED
 uniform int fractionCount;
 uniform vec4 fractionLabels;
 uniform int styleCount;
@@ -41,11 +41,37 @@ void cellOf(vec3 p, out ivec3 base, out vec3 f)
   f = x - vec3(base);
 }
 
+// The texture coordinate of IJK point p (clamped to the volume): texel
+// centres lie at (index + 0.5) / dimensions, so that the texture unit's
+// trilinear interpolation there is the CPU's between voxel values.
+vec3 filteredCoordinate(vec3 p) { return (clamp(p, vec3(0.0), vec3(dimensions - 1)) + 0.5) / dimensionsF; }
+
+// The weights of the shader's own interpolation: float, or (FILTER_WEIGHT_STEPS,
+// accuracy tests only) rounded to the fixed point of a texture unit's.
+vec3 interpolationWeights(vec3 f)
+{
+#ifdef FILTER_WEIGHT_STEPS
+  return round(f * FILTER_WEIGHT_STEPS) / FILTER_WEIGHT_STEPS;
+#else
+  return f;
+#endif
+}
+
+#ifdef ANATOMY_FILTERED
+// The texture unit's filtered R16 texel, value - anatomyMinimum over 65535:
+// the CPU's trilinear value to within the unit's weight precision (see
+// vtkVolumeCutOpenGLRayCaster::HardwareFiltering), one fetch instead of 8.
+float intensity(vec3 p)
+{
+  return anatomyMinimum + 65535.0 * textureLod(anatomyTexture, filteredCoordinate(p), 0.0).r;
+}
+#else
 float intensity(vec3 p)
 {
   ivec3 b;
   vec3 f;
   cellOf(p, b, f);
+  f = interpolationWeights(f);
   float v000 = anatomyAt(b);
   float v100 = anatomyAt(b + ivec3(1, 0, 0));
   float v010 = anatomyAt(b + ivec3(0, 1, 0));
@@ -62,6 +88,7 @@ float intensity(vec3 p)
   float c1 = c01 + f.y * (c11 - c01);
   return c0 + f.z * (c1 - c0);
 }
+#endif
 
 vec4 styleColor(int label) { return texelFetch(styleTexture, ivec2(label, 0), 0); }
 vec4 styleSurface(int label) { return texelFetch(styleTexture, ivec2(label, 1), 0); }
@@ -76,15 +103,20 @@ ivec3 cornerOffset(int corner) { return ivec3(corner & 1, (corner >> 1) & 1, (co
 
 vec4 fractionsAt(vec3 p)
 {
+#ifdef FRACTIONS_FILTERED
+  return textureLod(fractionTexture, filteredCoordinate(p), 0.0);
+#else
   ivec3 b;
   vec3 f;
   cellOf(p, b, f);
+  f = interpolationWeights(f);
   vec4 value = vec4(0.0);
   for (int corner = 0; corner < 8; ++corner)
   {
     value += cornerWeight(corner, f) * texelFetch(fractionTexture, b + cornerOffset(corner), 0);
   }
   return value;
+#endif
 }
 
 bool shownIsoSegment(int label)

@@ -58,6 +58,11 @@ def assert_same_image(expected, drawn):
         assert np.array_equal(a, b)
 
 
+def filtering(gpu):
+    """The features' suffix where the texture unit interpolates the 16-bit CT (test_volume_cut_gpu_filtering.py)."""
+    return " ct-filtered" if 0.0 <= gpu.GetFilterWeightError() <= gpu.GetMaximumFilterWeightError() else ""
+
+
 def test_programs_are_specialized_to_the_features_in_use(scene, intensities, tmp_path):
     window, mapper = cut_cube(scene, intensities, tmp_path)
     mapper.SetRequestedRenderPath(GPU)
@@ -73,7 +78,7 @@ def test_programs_are_specialized_to_the_features_in_use(scene, intensities, tmp
     def draw(name, expected_features):
         window.Render()
         assert mapper.GetLastRenderPath() == GPU, mapper.GetGPUFallbackReason()
-        assert gpu.GetProgramFeatures() == expected_features
+        assert gpu.GetProgramFeatures() == expected_features + filtering(gpu)
         sizes[name] = gpu.GetProgramSourceLength()
 
     draw("iso", "cuts=1 iso ct16 cut16")
@@ -231,7 +236,8 @@ def test_a_lost_context_between_programs_builds_again(scene, intensities, tmp_pa
     window.Finalize()
     window.Render()
     assert mapper.GetLastRenderPath() == GPU, mapper.GetGPUFallbackReason()
-    assert mapper.GetOpenGLRayCaster().GetProgramFeatures() == "cuts=1 iso thin-bone ct16 cut16"
+    gpu = mapper.GetOpenGLRayCaster()
+    assert gpu.GetProgramFeatures() == "cuts=1 iso thin-bone ct16 cut16" + filtering(gpu)
     drawn = read_window(window, WIDTH)
     depth, color = cpu_image(window, mapper)
     assert np.max(np.abs(depth - drawn[0])) < 1e-4

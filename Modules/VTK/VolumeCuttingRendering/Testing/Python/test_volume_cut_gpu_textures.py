@@ -3,10 +3,12 @@
 vtkVolumeCutOpenGLRayCaster uploads a CT whose values are integers spanning at
 most 65536 values as R16 (value - minimum), the labels as R8 or R16 and each
 cut field's brick atlas (whole quanta) as R16 (value + 32768); the shader
-turns each texel back into the float the CPU holds. So the image must
-be the one R32F textures give (NormalizedTexturesOff), pixel for pixel, and
-the CPU path's image within the mapper tests' tolerance; any other CT stays
-R32F. Rendered with whatever OpenGL VTK gives offscreen (Mesa llvmpipe here).
+turns each texel back into the float the CPU holds. So the image must be the
+one R32F textures give (NormalizedTexturesOff), pixel for pixel, when the
+shader interpolates (HardwareFilteringOff), and the CPU path's image within
+the mapper tests' tolerance when the texture unit does (the default,
+test_volume_cut_gpu_filtering.py); any other CT stays R32F. Rendered with
+whatever OpenGL VTK gives offscreen (Mesa llvmpipe here).
 """
 
 import numpy as np
@@ -93,15 +95,31 @@ def assert_same_image(expected, drawn):
 
 
 def both_formats(window, mapper):
-    """The GPU image with NormalizedTextures on, then off: images, CT bytes per voxel, program features."""
+    """The GPU image with NormalizedTextures on, then off, interpolated by the shader (HardwareFiltering off, so
+    that the 16-bit texels must give the very floats): images, CT bytes per voxel, program features."""
     gpu = mapper.GetOpenGLRayCaster()
+    gpu.HardwareFilteringOff()
     results = []
     for normalized in (True, False):
         gpu.SetNormalizedTextures(normalized)
         image = draw(window, mapper, GPU)
         results.append((image, gpu.GetAnatomyTextureBytesPerVoxel(), gpu.GetProgramFeatures(), gpu.GetTextureMemorySize()))
     gpu.NormalizedTexturesOn()
+    gpu.HardwareFilteringOn()
     return results
+
+
+def filtering_allowed(gpu):
+    """Whether this context's texture unit interpolates finely enough to filter (llvmpipe does, 8-bit GPUs do not)."""
+    return 0.0 <= gpu.GetFilterWeightError() <= gpu.GetMaximumFilterWeightError()
+
+
+def assert_filtered_like_cpu(window, mapper):
+    """The default GPU image, the 16-bit CT interpolated by the texture unit where allowed, within the CPU path's tolerance."""
+    image = draw(window, mapper, GPU)
+    gpu = mapper.GetOpenGLRayCaster()
+    assert gpu.GetAnatomyHardwareFiltered() == filtering_allowed(gpu)
+    assert_like_cpu(window, mapper, image)
 
 
 # (type, scale, offset): HU-like values for the wide types, what fits for the narrow ones;
@@ -130,6 +148,7 @@ def test_an_integer_ct_travels_as_16_bits_and_draws_what_floats_draw(scene, prog
     assert float_memory - unorm_memory == 2 * scene.dimensions**3 + 2 * atlas_texels
     assert_same_image(floats, unorm)
     assert_like_cpu(window, mapper, unorm)
+    assert_filtered_like_cpu(window, mapper)
 
 
 def test_the_16_bit_ct_composites_what_floats_composite(scene, program_cache):
@@ -174,6 +193,7 @@ def test_labels_travel_as_8_or_16_bits(scene, program_cache, largest, bytes_per_
     values, iso = cube_values(scene, 1.5, -1024.0)
     window, mapper = cut_view(scene, image_of(values, np.int16), iso, program_cache, labels=labels)
     gpu = mapper.GetOpenGLRayCaster()
+    gpu.HardwareFilteringOff()
     unorm = draw(window, mapper, GPU)
     assert gpu.GetLabelTextureBytesPerVoxel() == bytes_per_voxel
     assert gpu.GetAnatomyTextureBytesPerVoxel() == 2
@@ -188,6 +208,8 @@ def test_labels_travel_as_8_or_16_bits(scene, program_cache, largest, bytes_per_
     assert np.any(colors[:, 0] > 1.5 * colors[:, 2]) and np.any(colors[:, 0] < 1.5 * colors[:, 2])
     gpu.NormalizedTexturesOn()
     assert_like_cpu(window, mapper, draw(window, mapper, GPU))
+    gpu.HardwareFilteringOn()
+    assert_filtered_like_cpu(window, mapper)
 
 
 def test_a_ct_with_fractional_values_stays_32_bit_float(scene, program_cache):
@@ -223,6 +245,7 @@ def test_integers_shifted_by_a_common_fraction_are_16_bits_too(scene, program_ca
     assert (unorm_bytes, float_bytes) == (2, 4)
     assert_same_image(floats, unorm)
     assert_like_cpu(window, mapper, unorm)
+    assert_filtered_like_cpu(window, mapper)
 
 
 @pytest.mark.parametrize("with_label_map", [False, True])
@@ -240,6 +263,7 @@ def test_fractions_travel_as_16_bits_within_the_stated_tolerance(scene, program_
     caster.SetSegmentFraction(1, fraction)
     caster.SetSegmentAppearance(1, (0.2, 0.6, 0.9), 1.0, float("nan"))
     gpu = mapper.GetOpenGLRayCaster()
+    gpu.HardwareFilteringOff()
     unorm = draw(window, mapper, GPU)
     assert gpu.GetFractionTextureBytesPerVoxel() == 8
     memory = gpu.GetTextureMemorySize()
@@ -255,6 +279,9 @@ def test_fractions_travel_as_16_bits_within_the_stated_tolerance(scene, program_
     print("RGBA16 against RGBA32F fractions: depth differs by at most", np.max(np.abs(unorm[0] - floats[0])),
           "on", np.count_nonzero(unorm[0] != floats[0]), "pixels; colour by at most", np.max(np.abs(unorm[1] - floats[1])))
     assert_like_cpu(window, mapper, draw(window, mapper, GPU))
+    gpu.HardwareFilteringOn()
+    assert_filtered_like_cpu(window, mapper)
+    assert gpu.GetFractionsHardwareFiltered() == filtering_allowed(gpu)
 
 
 def test_a_cut_fields_atlas_travels_as_16_bits_exactly_before_and_after_a_stroke(scene, program_cache):
