@@ -104,7 +104,7 @@ def test_the_filtered_cut_cube_is_the_cpu_image_within_the_stated_tolerance(scen
     width = 96
     window, mapper = parity_view(scene, width, 8.0, program_cache)
     filtered, exact, (ct_filtered, _, features) = filtered_and_exact(window, mapper, width)
-    assert ct_filtered and features.endswith(" ct16 ct-filtered")
+    assert ct_filtered and features.endswith(" ct16 cut16 ct-filtered")
     cpu = draw(window, mapper, CPU, width)
     report("cut cube, 8 pixels per voxel", filtered, exact, cpu)
     assert np.array_equal(cpu[0] < 1.0, filtered[0] < 1.0)
@@ -126,7 +126,7 @@ def test_the_filtered_cube_composites_like_the_cpu(program_cache):
     set_transfer_functions(volume, [(0.0, 1.0, 1.0, 1.0), (1000.0, 1.0, 0.9, 0.8)], [(400.0, 0.0), (1000.0, 0.5)])
     mapper.SetBlendMode(vtk.vtkVolumeMapper.COMPOSITE_BLEND)
     filtered, exact, (ct_filtered, _, features) = filtered_and_exact(window, mapper, width)
-    assert ct_filtered and features == "cuts=1 composite ct16 ct-filtered"
+    assert ct_filtered and features == "cuts=1 composite ct16 cut16 ct-filtered"
     cpu = draw(window, mapper, CPU, width)
     report("composite cube", filtered, exact, cpu)
     assert np.mean(cpu[1][..., 3] > 0) > 0.2
