@@ -8,7 +8,8 @@ interval only where the trilinear CT reaches the iso-value along it. Each
 scene below is one where a wrong skip loses something: small specks and a
 thin shell that lie between samples, a surface just past a long empty run, a
 cavity floor just beyond the removed depth, rays that enter where the walk
-starts in a cell that may hold an object. Each must draw the CPU's image
+starts in a cell that may hold an object, wires whose CT peaks between the
+cell walls a ray crosses. Each must draw the CPU's image
 (the mapper tests' tolerance), and each must stop doing so when the skipping
 is deliberately broken (the broken code is injected before main() with
 SetExtraFragmentDeclarations): otherwise the scene would not test it.
@@ -122,6 +123,16 @@ def shell(n=48, radius=17.3, half_thickness=0.55):
     centre = 0.5 * (n - 1) + np.array([0.31, -0.22, 0.17])
     r = np.sqrt((i - centre[0]) ** 2 + (j - centre[1]) ** 2 + (k - centre[2]) ** 2)
     return BONE * np.clip(1.0 - np.abs(r - radius) / (2.0 * half_thickness), 0.0, 1.0)
+
+
+def wires(n=40, count=25, peak=900.0, seed=5):
+    """Columns of single bright voxels along k: beside one, the trilinear CT peaks between the cell walls a
+    ray crosses, above the iso-value where the walls' values stay under it."""
+    rng = np.random.default_rng(seed)
+    values = np.zeros((n, n, n))
+    for i, j in rng.integers(6, n - 6, size=(count, 2)):
+        values[6 : n - 6, j, i] = peak
+    return values
 
 
 def slab(n=48, face=29.37):
@@ -276,3 +287,15 @@ def test_a_cavity_floor_just_beyond_the_removed_depth(program_cache):
     camera = camera_on(c / s + [0.0, 0.0, 12.0], (0.25, -0.35, 1.0), pixels_per_voxel=2.2)
     view = View(values, camera, cut=scene.cut_field(2), program_cache=program_cache)
     assert_parity(view, {"cavity jump too far": CAVITY_JUMP_TOO_FAR})
+
+
+@pytest.mark.parametrize("direction", [(1.0, -1.0, 0.1), (1.0, 0.98, -0.2)])
+def test_peaks_between_cell_walls_are_refined_alike(direction, program_cache):
+    # Samples 1.5 voxels apart: the wires are found by refinement, which the
+    # exact test asks for only where the CT reaches the iso-value between two
+    # samples. A test that looks at the cell pieces' ends only (not where the
+    # cubic along a piece peaks) drew 26 and 83 pixels differently here.
+    n = 40
+    view = View(wires(n), camera_on([0.5 * (n - 1)] * 3, direction, pixels_per_voxel=1.6), program_cache=program_cache)
+    view.mapper.GetRayCaster().SetSampleDistance(1.5)
+    assert_parity(view, {"missing refinement": NO_REFINEMENT})
