@@ -159,7 +159,6 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   // (vtkVolumeCutEmptySpace's bytes), and whether rays walk them.
   vtkSmartPointer<vtkTextureObject> Cells;
   bool CellWalk = false;
-  int CellDimensions[3] = { 0, 0, 0 };
   vtkSmartPointer<vtkTextureObject> Transfer;
   vtkSmartPointer<vtkTextureObject> OpaqueDepth;
   CutTextures Cuts[MaximumNumberOfCutFields];
@@ -891,7 +890,6 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
       ? Internals::Texture3D(window, gd[0], gd[1], gd[2], 1, VTK_UNSIGNED_CHAR, GL_R8, view.CellGroups)
       : Internals::Texture3D(window, 1, 1, 1, 1, VTK_UNSIGNED_CHAR, GL_R8, &everyCell);
     impl.CellWalk = view.CellGroups != nullptr;
-    std::copy(gd, gd + 3, impl.CellDimensions);
     if (impl.Cells && Internals::BytesPerVoxel(impl.Cells) != 1)
     {
       // A driver without exact R8 texels: no walk rather than a wrong one.
