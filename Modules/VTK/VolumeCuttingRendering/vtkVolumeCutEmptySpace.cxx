@@ -149,7 +149,8 @@ void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximu
 //------------------------------------------------------------------------------
 void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int maximumThreads)
 {
-  this->CellBits.clear();
+  this->CellGroups.clear();
+  std::fill(this->GroupDimensions, this->GroupDimensions + 3, 0);
   const int* dims = scene.Dimensions;
   if (scene.BlendMode == 1 || dims[0] < 2 || dims[1] < 2 || dims[2] < 2)
   {
@@ -176,10 +177,18 @@ void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int m
   }
   const int cx = this->CellDimensions[0];
   const int cy = this->CellDimensions[1];
-  this->WordsPerCellLayer = (static_cast<size_t>(cx) * cy + 63) / 64;
-  this->CellBits.assign(this->WordsPerCellLayer * this->CellDimensions[2], 0);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    this->GroupDimensions[axis] = (this->CellDimensions[axis] + 1) / 2;
+  }
+  const size_t gx = this->GroupDimensions[0];
+  const size_t gy = this->GroupDimensions[1];
+  this->CellGroups.assign(gx * gy * this->GroupDimensions[2], 0);
   const vtkIdType sliceSize = static_cast<vtkIdType>(dims[0]) * dims[1];
-  vtkVolumeCutParallelFor(maximumThreads, this->CellDimensions[2], [&](vtkIdType beginZ, vtkIdType endZ) {
+  // Each thread builds whole layers of groups (two layers of cells).
+  vtkVolumeCutParallelFor(maximumThreads, this->GroupDimensions[2], [&](vtkIdType beginGroupZ, vtkIdType endGroupZ) {
+    const vtkIdType beginZ = 2 * beginGroupZ;
+    const vtkIdType endZ = std::min<vtkIdType>(2 * endGroupZ, this->CellDimensions[2]);
     // Per slice, the largest value and the lowest visibility of each 2 x 2
     // group of voxels; a cell takes those of its two slices.
     std::vector<float> high[2], low[2];
@@ -237,14 +246,19 @@ void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int m
     {
       const int current = static_cast<int>(k - beginZ) % 2;
       reduceSlice(static_cast<int>(k) + 1, high[1 - current], low[1 - current]);
-      uint64_t* layer = this->CellBits.data() + static_cast<size_t>(k) * this->WordsPerCellLayer;
-      for (size_t cell = 0; cell < static_cast<size_t>(cx) * cy; ++cell)
+      uint8_t* groups = this->CellGroups.data() + static_cast<size_t>(k / 2) * gx * gy;
+      const int layerBit = static_cast<int>(k & 1) << 2;
+      for (int j = 0; j < cy; ++j)
       {
-        const float h = std::max(high[0][cell], high[1][cell]);
-        const float l = std::min(low[0][cell], low[1][cell]);
-        if (h >= l)
+        for (int i = 0; i < cx; ++i)
         {
-          layer[cell / 64] |= uint64_t(1) << (cell % 64);
+          const size_t cell = i + static_cast<size_t>(cx) * j;
+          const float h = std::max(high[0][cell], high[1][cell]);
+          const float l = std::min(low[0][cell], low[1][cell]);
+          if (h >= l)
+          {
+            groups[(i >> 1) + gx * (j >> 1)] |= static_cast<uint8_t>(1u << ((i & 1) | (j & 1) << 1 | layerBit));
+          }
         }
       }
     }

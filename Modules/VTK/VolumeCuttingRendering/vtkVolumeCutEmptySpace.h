@@ -80,7 +80,7 @@ public:
    */
   double ExitEmptyCells(const double p[3], const double d[3], double t, double tEnd) const
   {
-    if (this->CellBits.empty())
+    if (this->CellGroups.empty())
     {
       return t;
     }
@@ -123,7 +123,7 @@ public:
    */
   bool MayHoldObject(const double p[3]) const
   {
-    if (this->CellBits.empty())
+    if (this->CellGroups.empty())
     {
       return true;
     }
@@ -137,7 +137,15 @@ public:
 
   const int* GetDimensions() const { return this->Dimensions; }
   const uint8_t* GetOccupied() const { return this->Occupied.data(); }
+  const uint8_t* GetReach() const { return this->Reach.data(); }
   const float* GetGradientBounds() const { return this->GradientBound.data(); }
+
+  /// Groups of 2 x 2 x 2 cells along each axis (0 where cells are not
+  /// classified: composite mode, or a volume of one slice).
+  const int* GetCellGroupDimensions() const { return this->GroupDimensions; }
+  /// Per group, a byte: bit (i & 1) | (j & 1) << 1 | (k & 1) << 2 set where
+  /// cell (i, j, k) may hold a visible object (nullptr when not classified).
+  const uint8_t* GetCellGroups() const { return this->CellGroups.empty() ? nullptr : this->CellGroups.data(); }
 
 private:
   vtkIdType BlockOf(const double p[3]) const
@@ -157,15 +165,18 @@ private:
 
   bool CellMayHoldObject(const int cell[3]) const
   {
-    const size_t bit = static_cast<size_t>(cell[0] + this->CellDimensions[0] * cell[1]);
-    return (this->CellBits[static_cast<size_t>(cell[2]) * this->WordsPerCellLayer + bit / 64] >> (bit % 64)) & 1u;
+    const size_t group = static_cast<size_t>(cell[0] >> 1) +
+      this->GroupDimensions[0] * (static_cast<size_t>(cell[1] >> 1) + static_cast<size_t>(this->GroupDimensions[1]) * (cell[2] >> 1));
+    return (this->CellGroups[group] >> ((cell[0] & 1) | (cell[1] & 1) << 1 | (cell[2] & 1) << 2)) & 1u;
   }
 
-  // Cells: one bit each, every layer of cells starting a new word so that
-  // threads building different layers never share one.
+  // Cells: one bit each, in bytes of 2 x 2 x 2 cells, the layout the GPU
+  // path uploads as it is (an R8 3D texture, 1/8 of a byte a cell: 16 MiB
+  // for a 512^3 CT); a ray's walk through neighbouring cells stays in few
+  // bytes. Threads build different layers of groups, so never share a byte.
   int CellDimensions[3] = { 0, 0, 0 };
-  size_t WordsPerCellLayer = 0;
-  std::vector<uint64_t> CellBits;
+  int GroupDimensions[3] = { 0, 0, 0 };
+  std::vector<uint8_t> CellGroups;
 
   int Dimensions[3] = { 0, 0, 0 };
   std::vector<uint8_t> Occupied;

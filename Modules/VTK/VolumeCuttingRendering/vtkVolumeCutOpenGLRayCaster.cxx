@@ -164,6 +164,7 @@ struct KeptImage
   vtkMTimeType AnatomyVersion = 0;
   vtkMTimeType LabelVersion = 0;
   std::string ProgramKey;
+  bool EmptySpaceSkipping = true;
   // Internals::OpaqueDepthVersion when it was cast.
   vtkTypeUInt64 OpaqueDepthVersion = 0;
   std::vector<vtkVolumeCutField*> Fields;
@@ -180,6 +181,10 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   vtkSmartPointer<vtkTextureObject> Fractions;
   vtkSmartPointer<vtkTextureObject> Styles;
   vtkSmartPointer<vtkTextureObject> Blocks;
+  // Per 2 x 2 x 2 cells, a bit per cell that may hold a visible object
+  // (vtkVolumeCutEmptySpace's bytes), and whether rays walk them.
+  vtkSmartPointer<vtkTextureObject> Cells;
+  bool CellWalk = false;
   vtkSmartPointer<vtkTextureObject> Transfer;
   vtkSmartPointer<vtkTextureObject> OpaqueDepth;
   CutTextures Cuts[MaximumNumberOfCutFields];
@@ -216,14 +221,14 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   void Release(vtkWindow* window)
   {
     for (vtkTextureObject* texture : { this->Anatomy.GetPointer(), this->Labels.GetPointer(), this->Fractions.GetPointer(), this->Styles.GetPointer(),
-           this->Blocks.GetPointer(), this->Transfer.GetPointer(), this->OpaqueDepth.GetPointer() })
+           this->Blocks.GetPointer(), this->Cells.GetPointer(), this->Transfer.GetPointer(), this->OpaqueDepth.GetPointer() })
     {
       if (texture)
       {
         texture->ReleaseGraphicsResources(window);
       }
     }
-    this->Anatomy = this->Labels = this->Fractions = this->Styles = this->Blocks = this->Transfer = this->OpaqueDepth = nullptr;
+    this->Anatomy = this->Labels = this->Fractions = this->Styles = this->Blocks = this->Cells = this->Transfer = this->OpaqueDepth = nullptr;
     for (CutTextures& cut : this->Cuts)
     {
       if (cut.Page)
@@ -820,6 +825,7 @@ size_t vtkVolumeCutOpenGLRayCaster::GetTextureMemorySize() const
   add(this->Impl->Fractions);
   add(this->Impl->Styles);
   add(this->Impl->Blocks);
+  add(this->Impl->Cells);
   add(this->Impl->Transfer);
   add(this->Impl->OpaqueDepth);
   add(this->Impl->Kept.Color);
@@ -1035,10 +1041,27 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
     std::vector<float> blockData(2 * blocks);
     for (size_t n = 0; n < blocks; ++n)
     {
-      blockData[2 * n] = view.BlockOccupied[n] ? 1.f : 0.f;
+      // The reach (0 for an occupied block) says both whether a block is
+      // empty and how far around it the ray may jump.
+      blockData[2 * n] = view.BlockOccupied[n] ? 0.f : float(std::max<int>(view.BlockReach[n], 1));
       blockData[2 * n + 1] = std::isfinite(view.BlockLipschitz[n]) ? view.BlockLipschitz[n] : 1e30f;
     }
     impl.Blocks = Internals::Texture3D(window, bd[0], bd[1], bd[2], 2, blockData.data());
+    // The cells' bytes as the CPU holds them; one byte with every cell kept
+    // where cells are not classified (the walk is off then).
+    const int* gd = view.CellGroupDimensions;
+    const unsigned char everyCell = 0xff;
+    impl.Cells = view.CellGroups
+      ? Internals::Texture3D(window, gd[0], gd[1], gd[2], 1, VTK_UNSIGNED_CHAR, GL_R8, view.CellGroups)
+      : Internals::Texture3D(window, 1, 1, 1, 1, VTK_UNSIGNED_CHAR, GL_R8, &everyCell);
+    impl.CellWalk = view.CellGroups != nullptr;
+    if (impl.Cells && Internals::BytesPerVoxel(impl.Cells) != 1)
+    {
+      // A driver without exact R8 texels: no walk rather than a wrong one.
+      impl.Cells->ReleaseGraphicsResources(window);
+      impl.Cells = Internals::Texture3D(window, 1, 1, 1, 1, VTK_UNSIGNED_CHAR, GL_R8, &everyCell);
+      impl.CellWalk = false;
+    }
     std::vector<float> transfer(4 * std::max(view.TableSize, 2), 0.f);
     if (view.ColorTable && view.OpacityTable)
     {
@@ -1049,7 +1072,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
       }
     }
     impl.Transfer = Internals::Texture2D(window, std::max(view.TableSize, 2), 1, 4, transfer.data());
-    if (!impl.Styles || !impl.Blocks || !impl.Transfer)
+    if (!impl.Styles || !impl.Blocks || !impl.Cells || !impl.Transfer)
     {
       this->LastErrorMessage = "the lookup tables do not fit in GPU memory";
       return false;
@@ -1205,6 +1228,15 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   program->SetUniformf("ambientOcclusionRadius", static_cast<float>(s->GetAmbientOcclusionRadius()));
   program->SetUniformi("refinements", view.MaximumRefinements);
   program->SetUniformi("bisectionSteps", 22);
+  program->SetUniformi("cellWalk", impl.CellWalk && this->EmptySpaceSkipping ? 1 : 0);
+  // A straight ray crosses fewer cells than the sum of the cell grid's sides.
+  program->SetUniformi("cellWalkSteps", dims[0] + dims[1] + dims[2]);
+  program->SetUniformi("reachJumps", this->EmptySpaceSkipping ? 1 : 0);
+  program->SetUniformi("exactHiddenBorders", this->EmptySpaceSkipping ? 1 : 0);
+  program->SetUniformi("cavityJumps", this->EmptySpaceSkipping ? 1 : 0);
+  // Cell pieces of one interval in the exact hidden-border test: a uniform
+  // bound (a constant would have drivers unroll the loop).
+  program->SetUniformi("intervalPieces", 16);
   program->SetUniformi("occlusionDirections", 7);
   const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
   float planes[6][4] = {};
@@ -1229,6 +1261,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   bindTexture(impl.Fractions, "fractionTexture");
   bindTexture(impl.Styles, "styleTexture");
   bindTexture(impl.Blocks, "blockTexture");
+  bindTexture(impl.Cells, "cellTexture");
   bindTexture(impl.OpaqueDepth, "opaqueDepthTexture");
   bindTexture(impl.Transfer, "transferTexture");
   for (int n = 0; n < cuts; ++n)
@@ -1260,7 +1293,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   const bool localized = this->LocalizedUpdates && kept.Valid && kept.Width == width && kept.Height == height &&
     std::equal(worldToNDCValues, worldToNDCValues + 16, kept.WorldToNDC) && kept.SceneVersion == view.Version &&
     kept.AnatomyVersion == view.AnatomyVersion && kept.LabelVersion == view.LabelVersion && kept.ProgramKey == impl.BuiltFeatures &&
-    kept.Fields == view.CutFields && kept.OpaqueDepthVersion == impl.OpaqueDepthVersion;
+    kept.EmptySpaceSkipping == this->EmptySpaceSkipping && kept.Fields == view.CutFields && kept.OpaqueDepthVersion == impl.OpaqueDepthVersion;
   if (!kept.Framebuffer || kept.Width != width || kept.Height != height)
   {
     if (!impl.AllocateKeptImage(window, width, height))
@@ -1319,6 +1352,7 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   kept.AnatomyVersion = view.AnatomyVersion;
   kept.LabelVersion = view.LabelVersion;
   kept.ProgramKey = impl.BuiltFeatures;
+  kept.EmptySpaceSkipping = this->EmptySpaceSkipping;
   kept.Fields = view.CutFields;
   kept.Stamps = currentStamps;
   kept.OpaqueDepthVersion = impl.OpaqueDepthVersion;
@@ -1410,6 +1444,7 @@ void vtkVolumeCutOpenGLRayCaster::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaximumFilterWeightError: " << this->MaximumFilterWeightError << " (measured " << this->FilterWeightError << ")\n";
   os << indent << "EmulatedFilterWeightBits: " << this->EmulatedFilterWeightBits << "\n";
   os << indent << "LocalizedUpdates: " << this->LocalizedUpdates << "\n";
+  os << indent << "EmptySpaceSkipping: " << this->EmptySpaceSkipping << "\n";
   os << indent << "NumberOfPixelsRecast: " << this->NumberOfPixelsRecast << (this->LastRenderWasLocalized ? " (localized)" : "")
      << ", region " << this->UpdatedRegion[0] << " " << this->UpdatedRegion[1] << " " << this->UpdatedRegion[2] << " "
      << this->UpdatedRegion[3] << "\n";

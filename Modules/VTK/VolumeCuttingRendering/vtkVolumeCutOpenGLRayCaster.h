@@ -168,6 +168,22 @@ public:
   vtkBooleanMacro(LocalizedUpdates, bool);
   ///@}
 
+  ///@{
+  /**
+   * Set/get whether rays skip empty space as the CPU path does: through
+   * cells where no visible object can be (to the last sample of the ray's
+   * grid before one that may hold it), across the cube of empty blocks
+   * around a sample, across the removed depth deep in a cavity, and with the
+   * exact test of whether the CT reaches the iso-value between two samples
+   * before an interval is refined. Off, rays jump one empty block at a time
+   * and refine where the block's gradient bound allows a border (the GPU
+   * path before; to measure what the skipping saves). Default is on.
+   */
+  vtkSetMacro(EmptySpaceSkipping, bool);
+  vtkGetMacro(EmptySpaceSkipping, bool);
+  vtkBooleanMacro(EmptySpaceSkipping, bool);
+  ///@}
+
   /// Whether the last successful Render recast only the rectangle of modified bricks.
   vtkGetMacro(LastRenderWasLocalized, bool);
 
@@ -343,6 +359,7 @@ protected:
   double MaximumFilterWeightError = 1.0 / 65536.0;
   double FilterWeightError = -1.0;
   bool LocalizedUpdates = true;
+  bool EmptySpaceSkipping = true;
   bool LastRenderWasLocalized = false;
   vtkIdType NumberOfPixelsRecast = 0;
   int UpdatedRegion[4] = { 0, 0, -1, -1 };

@@ -1024,6 +1024,9 @@ bool vtkVolumeCutRayCaster::UpdateScene(SceneView& view)
   std::copy(impl.Scene.EmptySpace.GetDimensions(), impl.Scene.EmptySpace.GetDimensions() + 3, view.BlockDimensions);
   view.BlockOccupied = impl.Scene.EmptySpace.GetOccupied();
   view.BlockLipschitz = impl.Scene.EmptySpace.GetGradientBounds();
+  view.BlockReach = impl.Scene.EmptySpace.GetReach();
+  std::copy(impl.Scene.EmptySpace.GetCellGroupDimensions(), impl.Scene.EmptySpace.GetCellGroupDimensions() + 3, view.CellGroupDimensions);
+  view.CellGroups = impl.Scene.EmptySpace.GetCellGroups();
   view.AnyIsoSegment = impl.Scene.AnyIsoSegment;
   view.MinimumIso = impl.Scene.MinimumIso;
   view.CutFields = impl.Scene.CutFields;

@@ -327,6 +327,13 @@ public:
     int BlockDimensions[3] = { 0, 0, 0 };
     const unsigned char* BlockOccupied = nullptr;
     const float* BlockLipschitz = nullptr;
+    /// Per block, the chessboard distance in blocks to the nearest occupied one (0: occupied; at most 255).
+    const unsigned char* BlockReach = nullptr;
+    /// Iso-surface mode: per 2 x 2 x 2 cells, a byte whose bit
+    /// (i & 1) | (j & 1) << 1 | (k & 1) << 2 says whether cell (i, j, k) may
+    /// hold a visible object; nullptr (and 0 groups) when cells are not classified.
+    int CellGroupDimensions[3] = { 0, 0, 0 };
+    const unsigned char* CellGroups = nullptr;
     bool AnyIsoSegment = false;
     double MinimumIso = 0.0;
     std::vector<vtkVolumeCutField*> CutFields;

@@ -9,6 +9,12 @@ fetches (off). On llvmpipe the frame time is a proxy only: a CPU rasterizer
 has no texture cache or memory bandwidth of a GPU's, and its filtering is
 code too, so the ratio says how much shader work filtering removes, not what
 a GPU gains.
+On the same cases it compares the GPU path's empty-space skipping as the
+CPU path does it (EmptySpaceSkipping on) with one empty block at a time
+(off): frame time, and how closely each draws the CPU path's image; on
+llvmpipe the ratio shows the work removed, not a GPU's speed. Every timed
+frame casts every ray (LocalizedUpdates off: a frame in which nothing
+changed would only show the kept image).
 
 A start is a new process (as a new start of the application), rendering the
 analytic cut cube of ``analyticscene.py`` on the GPU path; its build time is
@@ -146,13 +152,15 @@ def _image(array_kji) -> vtk.vtkImageData:
     return image
 
 
-def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256, switch: str = "NormalizedTextures") -> dict:
-    """GPU-path figures of one CT with its label map, with the caster's ``switch`` off and on, frames alternating:
-    NormalizedTextures (textures R32F against R16/R8) or HardwareFiltering (the texture unit interpolating the R16 CT)."""
+def _alternating_case(ct, labels, ijk_to_ras, repeats: int, switch: str, width: int = 256) -> dict:
+    """GPU-path figures of one CT with its label map, the OpenGL caster's boolean ``switch`` off and on, frames
+    alternating: NormalizedTextures (textures R32F or R16/R8), EmptySpaceSkipping (one block at a time or the CPU's skipping),
+    HardwareFiltering (the texture unit interpolating the R16 CT or the shader's texel fetches)."""
     import time
 
     import slicer_volumecutting as vc
     import vtk
+    from vtkmodules.util import numpy_support
 
     from .mapperbenchmarks import _finish
 
@@ -181,11 +189,9 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256, switch:
     mapper.SetProgramBuildTimeLimit(600.0)
     mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.GPUPath)
     gpu = mapper.GetOpenGLRayCaster()
-    # Every frame casts the whole image: an unchanged frame would otherwise
-    # only draw the kept image again.
+    # Every frame casts every ray: a frame in which nothing changed would otherwise only show the kept image.
     gpu.LocalizedUpdatesOff()
-    set_switch = getattr(gpu, "Set" + switch)
-    figures = {normalized: {"frame_s": [], "frame_cpu_s": [], "upload_frame_s": []} for normalized in (False, True)}
+    figures = {normalized: {"frame_s": [], "frame_cpu_s": [], "upload_frame_s": [], "pixels_recast": []} for normalized in (False, True)}
 
     def frame():
         window.Modified()
@@ -197,23 +203,48 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256, switch:
         return time.perf_counter() - start, time.process_time() - cpu
 
     # Both programs built before anything is timed.
+    def turn(on):
+        getattr(gpu, f"Set{switch}")(on)
+
     for normalized in (False, True):
-        set_switch(normalized)
+        turn(normalized)
         frame()
     for _ in range(repeats):
         for normalized in (False, True):
-            set_switch(normalized)
+            turn(normalized)
             figures[normalized]["upload_frame_s"].append(frame()[0])
             for _ in range(2):
                 wall, cpu = frame()
                 figures[normalized]["frame_s"].append(wall)
                 figures[normalized]["frame_cpu_s"].append(cpu)
+                figures[normalized]["pixels_recast"].append(gpu.GetNumberOfPixelsRecast())
             figures[normalized]["texture_bytes"] = gpu.GetTextureMemorySize()
             figures[normalized]["ct_bytes_per_voxel"] = gpu.GetAnatomyTextureBytesPerVoxel()
             figures[normalized]["label_bytes_per_voxel"] = gpu.GetLabelTextureBytesPerVoxel()
             figures[normalized]["features"] = gpu.GetProgramFeatures()
             figures[normalized]["ct_filtered"] = bool(gpu.GetAnatomyHardwareFiltered())
+    # Whether each setting draws the CPU path's surfaces: pixels covered on one path only, and the largest depth
+    # difference where both cover.
+    def depth_image(path):
+        mapper.SetRequestedRenderPath(path)
+        window.Modified()
+        window.Render()
+        depth = vtk.vtkFloatArray()
+        window.GetZbufferData(0, 0, width - 1, width - 1, depth)
+        return numpy_support.vtk_to_numpy(depth).copy()
+
+    cpu_depth = depth_image(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    agreement = {}
+    for normalized in (False, True):
+        turn(normalized)
+        depth = depth_image(vc.vtkVolumeCutVolumeMapper.GPUPath)
+        both = (depth < 1.0) & (cpu_depth < 1.0)
+        agreement["on" if normalized else "off"] = {
+            "pixels_covered_on_one_path_only": int(np.count_nonzero((depth < 1.0) != (cpu_depth < 1.0))),
+            "largest_depth_difference": float(np.max(np.abs(depth - cpu_depth)[both], initial=0.0)),
+        }
     return {
+        "agreement_with_the_cpu_path": agreement,
         "switch": switch,
         "filter_weight_error": gpu.GetFilterWeightError(),
         "dimensions": [int(ct.shape[2]), int(ct.shape[1]), int(ct.shape[0])],
@@ -224,23 +255,26 @@ def _format_case(ct, labels, ijk_to_ras, repeats: int, width: int = 256, switch:
     }
 
 
-def texture_formats(repeats: int) -> list[dict]:
+def _cases():
     from . import headct, patientscale
 
     head, _, head_ijk_to_ras = headct.load_array()
     patient = patientscale.generate(head=(head, head_ijk_to_ras))
-    cases = {
+    return {
         "head CT": (head, (head >= 300).astype(np.uint8), head_ijk_to_ras),
         "patient-scale case": (patient.ct, patient.labels, patient.ijk_to_ras),
     }
+
+
+def texture_formats(repeats: int, cases: dict) -> list[dict]:
     results = []
     for name, (ct, labels, ijk_to_ras) in cases.items():
-        figures = _format_case(ct, labels, ijk_to_ras, repeats)
-        del ct, labels
+        figures = _alternating_case(ct, labels, ijk_to_ras, repeats, "NormalizedTextures")
+        figures["float"], figures["normalized"] = figures.pop("off"), figures.pop("on")
         driver = figures["driver"]
         machine = machine_description(driver.split(", OpenGL")[0])
         size = " x ".join(str(d) for d in figures["dimensions"])
-        new, old = figures["on"], figures["off"]
+        new, old = figures["normalized"], figures["float"]
         memory = measurement(
             f"{name} ({size}) on the GPU path: texture memory, CT as R16 and labels as R8",
             new["texture_bytes"] / 2**20, "MiB", "the same with CT and labels as R32F (NormalizedTextures off)",
@@ -261,10 +295,10 @@ def texture_filtering(repeats: int) -> list[dict]:
 
     head, _, head_ijk_to_ras = headct.load_array()
     load_before = os.getloadavg()
-    figures = _format_case(head, (head >= 300).astype(np.uint8), head_ijk_to_ras, repeats, switch="HardwareFiltering")
+    figures = _alternating_case(head, (head >= 300).astype(np.uint8), head_ijk_to_ras, repeats, "HardwareFiltering")
     figures["load_average"] = {"before": [round(v, 2) for v in load_before], "after": [round(v, 2) for v in os.getloadavg()]}
     if not figures["on"]["ct_filtered"]:
-        raise RuntimeError(f"gpuprogram benchmark: the CT was not filtered ({figures['normalized']['features']}, "
+        raise RuntimeError(f"gpuprogram benchmark: the CT was not filtered ({figures['on']['features']}, "
                            f"interpolation error {figures['filter_weight_error']})")
     driver = figures["driver"]
     machine = machine_description(driver.split(", OpenGL")[0])
@@ -279,6 +313,31 @@ def texture_filtering(repeats: int) -> list[dict]:
             statistics.median(figures["off"][key]), repeats, machine)
         result["details"] = figures
         results.append(result)
+    return results
+
+
+def empty_space_skipping(repeats: int, cases: dict) -> list[dict]:
+    """The GPU path's frame time with the CPU's empty-space skipping (cell walk, reach and cavity jumps, exact
+    hidden-border test) against one empty block at a time (EmptySpaceSkipping off, the GPU path before it), frames
+    alternating in one process. llvmpipe rasterizes on the CPU: the ratio shows the work removed, not a GPU's speed."""
+    results = []
+    for name, (ct, labels, ijk_to_ras) in cases.items():
+        figures = _alternating_case(ct, labels, ijk_to_ras, repeats, "EmptySpaceSkipping")
+        driver = figures["driver"]
+        machine = machine_description(driver.split(", OpenGL")[0])
+        size = " x ".join(str(d) for d in figures["dimensions"])
+
+        figures["cell_texture_mib"] = float(np.prod([(d - 1 + 1) // 2 for d in figures["dimensions"]])) / 2**20
+        new, old = figures["on"], figures["off"]
+        for key, what in (("frame_s", "wall-clock"), ("frame_cpu_s", "processor time (llvmpipe's threads included)")):
+            result = measurement(
+                f"{name} ({size}) on the GPU path, iso-surface: frame time ({what}), CPU's empty-space skipping "
+                f"({driver.split(',')[0]}, the work removed, not a GPU's speed)",
+                statistics.median(new[key]), "s",
+                "the same frames skipping one empty block at a time (EmptySpaceSkipping off), alternating in the same process",
+                statistics.median(old[key]), repeats, machine)
+            result["details"] = figures
+            results.append(result)
     return results
 
 
@@ -327,4 +386,5 @@ def gpuprogram(repeats: int) -> list[dict]:
     ]
     for result in results:
         result["details"] = details
-    return results + texture_formats(repeats) + texture_filtering(repeats)
+    cases = _cases()
+    return results + texture_formats(repeats, cases) + texture_filtering(repeats) + empty_space_skipping(repeats, cases)

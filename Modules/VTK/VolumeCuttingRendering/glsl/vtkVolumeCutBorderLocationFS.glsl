@@ -117,6 +117,117 @@ float bisectCut(int n, Sample a, Sample b)
   return 0.5 * (lo + hi);
 }
 
+uniform int exactHiddenBorders;  // settle the gradient bound with reaches()
+uniform int intervalPieces;      // at most this many cell pieces in reaches()
+
+// Whether the trilinear CT reaches level somewhere on the segment from p to
+// q (IJK) (vtkVolumeCutSampleClassifier::Reaches): in each cell the segment
+// crosses, the value along it is a cubic in the segment's parameter, whose
+// maximum lies at an end of the piece or where its derivative vanishes. The
+// cells are walked in order, so no array holds the pieces.
+bool reaches(vec3 p, vec3 q, float level)
+{
+  vec3 d = q - p;
+  ivec3 wallStep = ivec3(sign(d));
+  // The next cell wall the segment crosses along each axis (an integer
+  // strictly beyond p), and its parameter; 2.0 (past the end) where none.
+  vec3 wall = vec3(0.0);
+  vec3 tWall = vec3(2.0);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    if (abs(d[axis]) >= 1e-12)
+    {
+      wall[axis] = d[axis] > 0.0 ? floor(p[axis]) + 1.0 : ceil(p[axis]) - 1.0;
+      tWall[axis] = (wall[axis] - p[axis]) / d[axis];
+    }
+  }
+  float t0 = 0.0;
+  for (int piece = 0; piece < intervalPieces; ++piece)
+  {
+    float t1 = min(min(min(tWall.x, tWall.y), tWall.z), 1.0);
+    if (t1 > t0)
+    {
+      ivec3 base;
+      vec3 f;
+      cellOf(p + 0.5 * (t0 + t1) * d, base, f);
+      float v000 = anatomyAt(base);
+      float v100 = anatomyAt(base + ivec3(1, 0, 0));
+      float v010 = anatomyAt(base + ivec3(0, 1, 0));
+      float v110 = anatomyAt(base + ivec3(1, 1, 0));
+      float v001 = anatomyAt(base + ivec3(0, 0, 1));
+      float v101 = anatomyAt(base + ivec3(1, 0, 1));
+      float v011 = anatomyAt(base + ivec3(0, 1, 1));
+      float v111 = anatomyAt(base + ivec3(1, 1, 1));
+      float highest = max(max(max(v000, v100), max(v010, v110)), max(max(v001, v101), max(v011, v111)));
+      float largest = max(highest, -min(min(min(v000, v100), min(v010, v110)), min(min(v001, v101), min(v011, v111))));
+      // Float arithmetic errs by about 1e-6 of the values' size: the margin,
+      // ten times that, errs towards a refined interval, never a missed one.
+      float margin = 1e-5 * (abs(level) + largest) + 1e-6;
+      if (highest + margin >= level)
+      {
+        // Trilinear value as A + Bx + Cy + Dz + Exy + Fxz + Gyz + Hxyz.
+        float B = v100 - v000;
+        float C = v010 - v000;
+        float D = v001 - v000;
+        float E = v110 - v010 - v100 + v000;
+        float F = v101 - v001 - v100 + v000;
+        float G = v011 - v001 - v010 + v000;
+        float H = v111 - v011 - v101 - v110 + v001 + v010 + v100 - v000;
+        vec3 o = p - vec3(base);
+        float k0 = v000 + B * o.x + C * o.y + D * o.z + E * o.x * o.y + F * o.x * o.z + G * o.y * o.z + H * o.x * o.y * o.z;
+        float k1 = B * d.x + C * d.y + D * d.z + E * (o.x * d.y + o.y * d.x) + F * (o.x * d.z + o.z * d.x) +
+          G * (o.y * d.z + o.z * d.y) + H * (d.x * o.y * o.z + o.x * d.y * o.z + o.x * o.y * d.z);
+        float k2 = E * d.x * d.y + F * d.x * d.z + G * d.y * d.z + H * (d.x * d.y * o.z + d.x * o.y * d.z + o.x * d.y * d.z);
+        float k3 = H * d.x * d.y * d.z;
+        if (k0 + t0 * (k1 + t0 * (k2 + t0 * k3)) + margin >= level || k0 + t1 * (k1 + t1 * (k2 + t1 * k3)) + margin >= level)
+        {
+          return true;
+        }
+        // Stationary points: roots of k1 + 2 k2 t + 3 k3 t^2.
+        float a2 = 3.0 * k3;
+        float a1 = 2.0 * k2;
+        float root0 = 2.0;
+        float root1 = 2.0;
+        if (abs(a2) > 1e-30)
+        {
+          float discriminant = a1 * a1 - 4.0 * a2 * k1;
+          if (discriminant >= 0.0)
+          {
+            float root = sqrt(discriminant);
+            root0 = (-a1 - root) / (2.0 * a2);
+            root1 = (-a1 + root) / (2.0 * a2);
+          }
+        }
+        else if (abs(a1) > 1e-30)
+        {
+          root0 = -k1 / a1;
+        }
+        if ((root0 > t0 && root0 < t1 && k0 + root0 * (k1 + root0 * (k2 + root0 * k3)) + margin >= level) ||
+          (root1 > t0 && root1 < t1 && k0 + root1 * (k1 + root1 * (k2 + root1 * k3)) + margin >= level))
+        {
+          return true;
+        }
+      }
+    }
+    if (t1 >= 1.0)
+    {
+      return false;
+    }
+    // Past the wall (or walls, at an edge or corner) at t1.
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      if (tWall[axis] <= t1)
+      {
+        wall[axis] += float(wallStep[axis]);
+        tWall[axis] = (wall[axis] - p[axis]) / d[axis];
+      }
+    }
+    t0 = t1;
+  }
+  // More pieces than the bound: as if the CT reached the level.
+  return true;
+}
+
 bool mayHideBorders(Sample a, Sample b, float lengthVoxels, float lengthMillimetres)
 {
   if (a.object == 0 && b.object == 0)
@@ -126,7 +237,13 @@ bool mayHideBorders(Sample a, Sample b, float lengthVoxels, float lengthMillimet
       return false;
     }
     float slope = max(texelFetch(blockTexture, blockOf(a.index), 0).g, texelFetch(blockTexture, blockOf(b.index), 0).g);
-    return 0.5 * (a.value + b.value + slope * lengthVoxels) >= minimumIso;
+    if (0.5 * (a.value + b.value + slope * lengthVoxels) < minimumIso)
+    {
+      return false;
+    }
+    // The block's gradient bound is loose beside bone, where it would have
+    // every step split; the exact maximum along the interval settles those.
+    return exactHiddenBorders == 0 || reaches(a.index, b.index, minimumIso);
   }
   if (!a.cutsKnown || !b.cutsKnown)
   {

@@ -40,6 +40,18 @@ bool removed(Sample s)
   return false;
 }
 
+// Where a sample's removed depth ends: the cut fields are distances (1 mm
+// per mm), so no field's border lies nearer along the ray than this.
+float removedDepthExit(Sample s)
+{
+  float exitT = s.t;
+  for (int n = 0; n < NUMBER_OF_CUTS; ++n)
+  {
+    exitT = max(exitT, s.t - s.distance[n]);
+  }
+  return exitT;
+}
+
 bool visible(inout Sample s)
 {
   if (s.object == 0)

@@ -26,6 +26,7 @@ uniform mat3 normalMatrix;
 uniform vec2 viewportSize;
 uniform float sampleDistance;
 uniform int blendMode;
+uniform int cavityJumps;  // deep in a cavity, jump across the removed depth
 
 #define BLOCK 8
 #define SOURCE_OBJECT 1
@@ -134,6 +135,33 @@ void main()
           insideVisible = visible(a);
           done = insideVisible && enter(a, a.t, SOURCE_OBJECT);
         }
+        continue;
+      }
+    }
+    if (!composite)
+    {
+      // Where nothing can show ahead, the ray jumps to the last sample on
+      // its sample grid before it may (the samples stay where a march
+      // without the jump puts them, so that the same grazing rays catch a
+      // surface's rim as on the CPU): through cells where nothing visible
+      // can be, or deep in a cavity across the removed depth of this
+      // sample.
+      float clearUntil = a.t;
+      if (a.object == 0)
+      {
+        clearUntil = exitEmptyCells(a.index, a.t, tEnd);
+      }
+      else if (cavityJumps != 0 && !insideVisible && a.cutsKnown)
+      {
+        clearUntil = removedDepthExit(a);
+      }
+      float landing = a.t + floor((min(clearUntil, tEnd) - a.t) / stepLength) * stepLength;
+      if (landing > a.t + stepLength)
+      {
+        a = sampleAt(landing);
+        evaluateObject(a);
+        insideVisible = visible(a);
+        done = insideVisible && enter(a, a.t, SOURCE_OBJECT);
         continue;
       }
     }
