@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 import slicer_volumecutting as vc
 import vtk
-from test_volume_cut_gpu_textures import draw, image_of
+from test_volume_cut_gpu_textures import assert_images_agree, draw, image_of
 from test_volume_cut_mapper import add_cut_volume, render_window, set_transfer_functions, sphere_segment
 from vtk.util import numpy_support
 
@@ -84,10 +84,10 @@ def filtered_and_exact(window, mapper, width):
 
 
 def assert_within_tolerance(cpu, gpu):
-    """The mapper tests' stated CPU/GPU tolerance: depth within 1e-4, colour within 2 levels but for 0.5 % of the pixels."""
-    assert np.any(cpu[0] < 1.0)
-    assert np.max(np.abs(cpu[0] - gpu[0])) < 1e-4
-    assert np.mean(np.max(np.abs(cpu[1] - gpu[1]), axis=2) > 2) < 0.005
+    """The mapper tests' stated CPU/GPU tolerance: depth within 1e-4, colour within 2 levels but for 0.5 % of the
+    pixels; a silhouette pixel a ray grazes for less than a refined sub-interval may be covered on one path only
+    (float against double), at most 0.1 % of them (test_volume_cut_gpu_textures.assert_like_cpu)."""
+    assert_images_agree(cpu, gpu)
 
 
 def report(name, filtered, exact, cpu):

@@ -89,7 +89,12 @@ def assert_like_cpu(window, mapper, gpu_image):
     GPU's samples shifted by 3e-6 mm miss it too), float against double. Such
     a rim pixel may be covered on one path only, at most 0.1 % of them.
     """
-    cpu_depth, cpu_color = draw(window, mapper, CPU)
+    assert_images_agree(draw(window, mapper, CPU), gpu_image)
+
+
+def assert_images_agree(cpu_image, gpu_image):
+    """assert_like_cpu's tolerance for two (depth, colour) images already drawn."""
+    cpu_depth, cpu_color = cpu_image
     gpu_depth, gpu_color = gpu_image
     assert np.any(cpu_depth < 1.0)
     both = (cpu_depth < 1.0) & (gpu_depth < 1.0)
