@@ -191,6 +191,9 @@ def _alternating_case(ct, labels, ijk_to_ras, repeats: int, switch: str, width: 
     gpu = mapper.GetOpenGLRayCaster()
     # Every frame casts every ray: a frame in which nothing changed would otherwise only show the kept image.
     gpu.LocalizedUpdatesOff()
+    if switch == "NormalizedTextures":
+        # The shader's texel fetches with either format: the row shows the format alone (R32F is never filtered).
+        gpu.HardwareFilteringOff()
     figures = {normalized: {"frame_s": [], "frame_cpu_s": [], "upload_frame_s": [], "pixels_recast": []} for normalized in (False, True)}
 
     def frame():
