@@ -150,31 +150,24 @@ bool reaches(vec3 p, vec3 q, float level)
       ivec3 base;
       vec3 f;
       cellOf(p + 0.5 * (t0 + t1) * d, base, f);
-      float v000 = anatomyAt(base);
-      float v100 = anatomyAt(base + ivec3(1, 0, 0));
-      float v010 = anatomyAt(base + ivec3(0, 1, 0));
-      float v110 = anatomyAt(base + ivec3(1, 1, 0));
-      float v001 = anatomyAt(base + ivec3(0, 0, 1));
-      float v101 = anatomyAt(base + ivec3(1, 0, 1));
-      float v011 = anatomyAt(base + ivec3(0, 1, 1));
-      float v111 = anatomyAt(base + ivec3(1, 1, 1));
-      float highest = max(max(max(v000, v100), max(v010, v110)), max(max(v001, v101), max(v011, v111)));
-      float largest = max(highest, -min(min(min(v000, v100), min(v010, v110)), min(min(v001, v101), min(v011, v111))));
+      CellValues c = cellValuesAt(base);
+      float highest = max(max(max(c.v000, c.v100), max(c.v010, c.v110)), max(max(c.v001, c.v101), max(c.v011, c.v111)));
+      float largest = max(highest, -min(min(min(c.v000, c.v100), min(c.v010, c.v110)), min(min(c.v001, c.v101), min(c.v011, c.v111))));
       // Float arithmetic errs by about 1e-6 of the values' size: the margin,
       // ten times that, errs towards a refined interval, never a missed one.
       float margin = 1e-5 * (abs(level) + largest) + 1e-6;
       if (highest + margin >= level)
       {
         // Trilinear value as A + Bx + Cy + Dz + Exy + Fxz + Gyz + Hxyz.
-        float B = v100 - v000;
-        float C = v010 - v000;
-        float D = v001 - v000;
-        float E = v110 - v010 - v100 + v000;
-        float F = v101 - v001 - v100 + v000;
-        float G = v011 - v001 - v010 + v000;
-        float H = v111 - v011 - v101 - v110 + v001 + v010 + v100 - v000;
+        float B = c.v100 - c.v000;
+        float C = c.v010 - c.v000;
+        float D = c.v001 - c.v000;
+        float E = c.v110 - c.v010 - c.v100 + c.v000;
+        float F = c.v101 - c.v001 - c.v100 + c.v000;
+        float G = c.v011 - c.v001 - c.v010 + c.v000;
+        float H = c.v111 - c.v011 - c.v101 - c.v110 + c.v001 + c.v010 + c.v100 - c.v000;
         vec3 o = p - vec3(base);
-        float k0 = v000 + B * o.x + C * o.y + D * o.z + E * o.x * o.y + F * o.x * o.z + G * o.y * o.z + H * o.x * o.y * o.z;
+        float k0 = c.v000 + B * o.x + C * o.y + D * o.z + E * o.x * o.y + F * o.x * o.z + G * o.y * o.z + H * o.x * o.y * o.z;
         float k1 = B * d.x + C * d.y + D * d.z + E * (o.x * d.y + o.y * d.x) + F * (o.x * d.z + o.z * d.x) +
           G * (o.y * d.z + o.z * d.y) + H * (d.x * o.y * o.z + o.x * d.y * o.z + o.x * o.y * d.z);
         float k2 = E * d.x * d.y + F * d.x * d.z + G * d.y * d.z + H * (d.x * d.y * o.z + d.x * o.y * d.z + o.x * d.y * d.z);

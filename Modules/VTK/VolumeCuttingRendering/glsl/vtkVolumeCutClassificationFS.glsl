@@ -57,6 +57,26 @@ vec3 interpolationWeights(vec3 f)
 #endif
 }
 
+// The CT at a cell's eight corners (named, not an array: arrays indexed at
+// run time go to slow local memory on NVIDIA).
+struct CellValues
+{
+  float v000;
+  float v100;
+  float v010;
+  float v110;
+  float v001;
+  float v101;
+  float v011;
+  float v111;
+};
+
+CellValues cellValuesAt(ivec3 b)
+{
+  return CellValues(anatomyAt(b), anatomyAt(b + ivec3(1, 0, 0)), anatomyAt(b + ivec3(0, 1, 0)), anatomyAt(b + ivec3(1, 1, 0)),
+    anatomyAt(b + ivec3(0, 0, 1)), anatomyAt(b + ivec3(1, 0, 1)), anatomyAt(b + ivec3(0, 1, 1)), anatomyAt(b + ivec3(1, 1, 1)));
+}
+
 #ifdef ANATOMY_FILTERED
 // The texture unit's filtered R16 texel, value - anatomyMinimum over 65535:
 // the CPU's trilinear value to within the unit's weight precision (see
@@ -72,18 +92,11 @@ float intensity(vec3 p)
   vec3 f;
   cellOf(p, b, f);
   f = interpolationWeights(f);
-  float v000 = anatomyAt(b);
-  float v100 = anatomyAt(b + ivec3(1, 0, 0));
-  float v010 = anatomyAt(b + ivec3(0, 1, 0));
-  float v110 = anatomyAt(b + ivec3(1, 1, 0));
-  float v001 = anatomyAt(b + ivec3(0, 0, 1));
-  float v101 = anatomyAt(b + ivec3(1, 0, 1));
-  float v011 = anatomyAt(b + ivec3(0, 1, 1));
-  float v111 = anatomyAt(b + ivec3(1, 1, 1));
-  float c00 = v000 + f.x * (v100 - v000);
-  float c10 = v010 + f.x * (v110 - v010);
-  float c01 = v001 + f.x * (v101 - v001);
-  float c11 = v011 + f.x * (v111 - v011);
+  CellValues c = cellValuesAt(b);
+  float c00 = c.v000 + f.x * (c.v100 - c.v000);
+  float c10 = c.v010 + f.x * (c.v110 - c.v010);
+  float c01 = c.v001 + f.x * (c.v101 - c.v001);
+  float c11 = c.v011 + f.x * (c.v111 - c.v011);
   float c0 = c00 + f.y * (c10 - c00);
   float c1 = c01 + f.y * (c11 - c01);
   return c0 + f.z * (c1 - c0);

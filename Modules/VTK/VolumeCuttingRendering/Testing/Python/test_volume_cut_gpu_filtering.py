@@ -22,7 +22,7 @@ import pytest
 import slicer_volumecutting as vc
 import vtk
 from test_volume_cut_gpu_textures import assert_images_agree, draw, image_of
-from test_volume_cut_mapper import add_cut_volume, render_window, set_transfer_functions, sphere_segment
+from test_volume_cut_mapper import add_cut_volume, look_down_z, render_window, set_transfer_functions, sphere_segment
 from vtk.util import numpy_support
 
 from VolumeCuttingLib import analyticscene as A
@@ -221,13 +221,7 @@ def sphere_view(program_cache, width=64):
     z, y, x = np.meshgrid(np.arange(n) - c[2], np.arange(n) - c[1], np.arange(n) - c[0], indexing="ij")
     values = np.rint(1000.0 * np.clip(0.5 - (np.sqrt(x * x + y * y + z * z) - radius) / 2.0, 0.0, 1.0))
     window, renderer = render_window(width)
-    camera = renderer.GetActiveCamera()
-    camera.ParallelProjectionOn()
-    camera.SetParallelScale(11.0)
-    camera.SetFocalPoint(*c)
-    camera.SetPosition(c[0], c[1], c[2] + 50.0)
-    camera.SetViewUp(0.0, 1.0, 0.0)
-    camera.SetClippingRange(20.0, 80.0)
+    camera = look_down_z(renderer.GetActiveCamera(), c, 11.0)
     mapper = vc.vtkVolumeCutVolumeMapper()
     mapper.SetInputData(image_of(values, np.int16))
     mapper.GetRayCaster().SetIsoValue(500.0)

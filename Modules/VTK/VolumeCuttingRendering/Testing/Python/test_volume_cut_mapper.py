@@ -483,6 +483,17 @@ def sphere_segment(n, center, radius, supersampling=4):
     return image(fraction.astype(np.float32), vtk.VTK_FLOAT), image(binary, vtk.VTK_UNSIGNED_SHORT)
 
 
+def look_down_z(camera, center, half_height):
+    """``camera`` in parallel projection looking down z at ``center`` from 50 mm, showing 2 * half_height mm."""
+    camera.ParallelProjectionOn()
+    camera.SetParallelScale(half_height)
+    camera.SetFocalPoint(*center)
+    camera.SetPosition(center[0], center[1], center[2] + 50.0)
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(20.0, 80.0)
+    return camera
+
+
 def test_fractional_labelmaps_place_segment_surfaces_at_sub_voxel_accuracy():
     n, center, radius = 32, (15.3, 15.6, 15.2), 9.0
     fraction, binary = sphere_segment(n, center, radius)
@@ -490,13 +501,7 @@ def test_fractional_labelmaps_place_segment_surfaces_at_sub_voxel_accuracy():
     ct.SetDimensions(n, n, n)
     ct.AllocateScalars(vtk.VTK_FLOAT, 1)
     ct.GetPointData().GetScalars().Fill(0.0)
-    camera = vtk.vtkCamera()
-    camera.ParallelProjectionOn()
-    camera.SetParallelScale(11.0)
-    camera.SetFocalPoint(*center)
-    camera.SetPosition(center[0], center[1], center[2] + 50.0)
-    camera.SetViewUp(0.0, 1.0, 0.0)
-    camera.SetClippingRange(20.0, 80.0)
+    camera = look_down_z(vtk.vtkCamera(), center, 11.0)
     width = 64
     matrix = A.world_to_ndc(camera, width, width)
     errors = {}
