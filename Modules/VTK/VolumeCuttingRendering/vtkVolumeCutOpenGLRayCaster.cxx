@@ -49,13 +49,13 @@ void ColumnMajor(const double rowMajor[16], float out[16])
   }
 }
 
-// Whether the CT loses nothing as a 16-bit unsigned normalized texture: each
-// value v is minimum + k (float arithmetic, as the shader adds them) for an
-// integer k in 0..65535. If so, texels holds each k and minimum is set.
 // A cut field's distances (short quanta) travel in R16 as value + this; the
 // shader subtracts it (glsl/vtkVolumeCutCutFieldFS.glsl).
 constexpr int CutAtlasOffset = 32768;
 
+// Whether the CT loses nothing as a 16-bit unsigned normalized texture: each
+// value v is minimum + k (float arithmetic, as the shader adds them) for an
+// integer k in 0..65535. If so, texels holds each k and minimum is set.
 bool ToUnorm16(const float* values, size_t count, float& minimum, std::vector<unsigned short>& texels)
 {
   if (count == 0)
@@ -205,8 +205,11 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
   float AnatomyMinimum = 0.f;
   float LabelScale = 1.f;
   vtkMTimeType SceneVersion = 0;
-  // The texture unit's interpolation error in this context (-1: not measured yet).
+  // The texture unit's interpolation error in this context (-1: it cannot
+  // filter R16), measured once a context: a driver that cannot is not
+  // probed again every frame.
   double FilterWeightError = -1.0;
+  bool FilterWeightMeasured = false;
   // The program for the features of the last Render, and the quad it draws.
   vtkVolumeCutProgramBuilder Builder;
   std::string BuiltFeatures;
@@ -270,6 +273,7 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
     this->AnatomyUnorm16 = false;
     this->FractionsUnorm16 = false;
     this->FilterWeightError = -1.0;
+    this->FilterWeightMeasured = false;
     this->Context = nullptr;
   }
 
@@ -649,7 +653,6 @@ struct vtkVolumeCutOpenGLRayCaster::Internals
       glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
       if (cut.Unorm16)
       {
-        glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
         glTexSubImage3D(GL_TEXTURE_3D, 0, 8 * (slot % s), 8 * ((slot / s) % s), 8 * (slot / (s * s)), 8, 8, 8, GL_RED,
           GL_UNSIGNED_SHORT, shifted.data());
       }
@@ -1145,9 +1148,10 @@ bool vtkVolumeCutOpenGLRayCaster::Render(vtkOpenGLRenderWindow* window, vtkVolum
   // Only 16-bit normalized textures are filtered (R32F is not filterable
   // everywhere: OES_texture_float_linear; labels are never interpolated),
   // and only by a texture unit that weights texels finely enough.
-  if (this->HardwareFiltering && impl.FilterWeightError < 0.0 && (impl.AnatomyUnorm16 || impl.FractionsUnorm16))
+  if (this->HardwareFiltering && !impl.FilterWeightMeasured && (impl.AnatomyUnorm16 || impl.FractionsUnorm16))
   {
     impl.FilterWeightError = impl.MeasureFilterWeightError(window);
+    impl.FilterWeightMeasured = true;
   }
   this->FilterWeightError = impl.FilterWeightError;
   const bool precise = this->HardwareFiltering && impl.FilterWeightError >= 0.0 && impl.FilterWeightError <= this->MaximumFilterWeightError;
