@@ -3,6 +3,8 @@
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutFieldFile.h"
 #include "vtkVolumeCutFieldDistanceSource.h"
+#include "vtkVolumeCutFieldInternals.h"
+#include "vtkVolumeCutFieldUndoHistory.h"
 #include "vtkVolumeCutKernels.h"
 #include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutProtectionBrick.h"
@@ -33,103 +35,22 @@
 
 vtkStandardNewMacro(vtkVolumeCutField);
 
-namespace
-{
-constexpr int BrickSize = vtkVolumeCutField::BrickSize;
-constexpr int SamplesPerBrick = BrickSize * BrickSize * BrickSize;
-constexpr int16_t Outside = vtkVolumeCutKernels::Outside;
-constexpr int16_t Inside = vtkVolumeCutKernels::Inside;
-static_assert(Outside == std::numeric_limits<int16_t>::max() && Inside == -Outside, "the band spans the 16-bit range");
-static_assert(SamplesPerBrick == vtkVolumeCutKernels::SamplesPerBrick, "kernels work on whole bricks");
+using vtkVolumeCutFieldInternals::BrickSize;
+using vtkVolumeCutFieldInternals::Inside;
+using vtkVolumeCutFieldInternals::IsFinite;
+using vtkVolumeCutFieldInternals::Outside;
+using vtkVolumeCutFieldInternals::SamplesPerBrick;
+using vtkVolumeCutFieldInternals::Transform;
+
 static_assert(int(vtkVolumeCutField::InstructionSetAVX2) == int(vtkVolumeCutKernels::AVX2) && int(vtkVolumeCutField::InstructionSetAVX512) == int(vtkVolumeCutKernels::AVX512),
   "one numbering of the instruction sets");
-
-bool IsFinite(const double v[3])
-{
-  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-}
-
-void Transform(const double m[4][4], const double in[3], double out[3])
-{
-  for (int row = 0; row < 3; ++row)
-  {
-    out[row] = m[row][0] * in[0] + m[row][1] * in[1] + m[row][2] * in[2] + m[row][3];
-  }
-}
-} // namespace
-
-//------------------------------------------------------------------------------
-struct vtkVolumeCutField::Brick
-{
-  explicit Brick(vtkIdType id)
-    : Id(id)
-  {
-    // Plain stores, which vectorise: no reader sees the brick before the
-    // directory publishes it (release).
-    int16_t* values = reinterpret_cast<int16_t*>(this->Values);
-    std::fill(values, values + SamplesPerBrick, Outside);
-  }
-  const vtkIdType Id;
-  // Seqlock: odd while the writer changes the values.
-  std::atomic<uint32_t> Sequence{ 0 };
-  std::atomic<vtkTypeUInt64> Stamp{ 0 };
-  std::atomic<int16_t> Values[SamplesPerBrick];
-
-  /// The values as the writer thread sees them, for loops that vectorise:
-  /// other threads only read, so the writer's own plain reads race with
-  /// nothing (lock-free 16-bit atomics have the layout of the integer).
-  const int16_t* WriterView() const { return reinterpret_cast<const int16_t*>(this->Values); }
-
-  /// The writer's own record that every sample is Inside: no cut can change
-  /// the brick then (Inside is the least value), so strokes skip it.
-  bool AllInside = false;
-  /// The writer's own record of the stroke (StrokeSerial) whose undo step
-  /// holds the brick as it was: a stroke's later changes need no look-up.
-  vtkTypeUInt64 RememberedInStroke = 0;
-  void UpdateAllInside()
-  {
-    const int16_t* values = this->WriterView();
-    int differing = 0;
-    for (int index = 0; index < SamplesPerBrick; ++index)
-    {
-      differing |= values[index] != Inside;
-    }
-    this->AllInside = differing == 0;
-  }
-};
-static_assert(sizeof(std::atomic<int16_t>) == sizeof(int16_t), "16-bit atomics must have the layout of the integer");
-
-//------------------------------------------------------------------------------
-/// One stroke's bricks as they were before it (empty values: the brick did
-/// not exist, all Outside). The state after it is read back when the stroke
-/// is undone (until then the field holds it: every later change is a later
-/// step, undone first, or clears the history), so closing a stroke copies
-/// nothing; steps waiting to be redone hold both.
-struct vtkVolumeCutField::UndoStep
-{
-  BrickStates Before;
-  BrickStates After;
-  size_t Memory = 0; // bytes held, kept by whoever changes Before or After
-
-  static size_t EntryMemory(const BrickValues& values) { return values.size() * sizeof(int16_t) + 64; }
-  size_t MemorySize() const { return this->Memory; }
-  void CountMemory()
-  {
-    this->Memory = 0;
-    for (const BrickStates* states : { &this->Before, &this->After })
-    {
-      for (const auto& entry : *states)
-      {
-        this->Memory += EntryMemory(entry.second);
-      }
-    }
-  }
-};
 
 //------------------------------------------------------------------------------
 vtkVolumeCutField::vtkVolumeCutField()
   : Protection(vtkSmartPointer<vtkVolumeCutProtection>::New())
+  , History(vtkSmartPointer<vtkVolumeCutFieldUndoHistory>::New())
 {
+  this->History->SetField(this);
   vtkMatrix4x4::Identity(&this->SubIJKToRAS[0][0]);
   vtkMatrix4x4::Identity(&this->RASToSubIJK[0][0]);
 }
@@ -140,13 +61,13 @@ vtkVolumeCutField::~vtkVolumeCutField() = default;
 //------------------------------------------------------------------------------
 int vtkVolumeCutField::GetNumberOfUndoSteps() const
 {
-  return static_cast<int>(this->UndoStack.size());
+  return this->History->GetNumberOfUndoSteps();
 }
 
 //------------------------------------------------------------------------------
 int vtkVolumeCutField::GetNumberOfRedoSteps() const
 {
-  return static_cast<int>(this->RedoStack.size());
+  return this->History->GetNumberOfRedoSteps();
 }
 
 //------------------------------------------------------------------------------
@@ -294,12 +215,7 @@ void vtkVolumeCutField::Reset()
   this->AllocatedBrickIds.reset();
   this->NumberOfAllocatedBricks.store(0, std::memory_order_release);
   this->OwnedBricks.clear();
-  this->UndoStack.clear();
-  this->RedoStack.clear();
-  this->UndoMemorySize = 0;
-  this->StrokeOpen = false;
-  this->StrokeBefore.clear();
-  this->StrokeBeforeMemory = 0;
+  this->History->Clear();
   this->Protection->RemoveAllLabelImages();
   this->LastCapsule.Valid = false;
   this->LastToolSweep.Valid = false;
@@ -499,32 +415,6 @@ vtkVolumeCutField::Brick* vtkVolumeCutField::GetOrCreateBrick(vtkIdType brickId)
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutField::RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick)
-{
-  if (brick && brick->RememberedInStroke == this->StrokeSerial)
-  {
-    return;
-  }
-  // A brick that did not exist is remembered empty (all Outside): a moving
-  // burr enters new bricks every few segments, and the haptic thread should
-  // not fill kilobytes of Outside for each.
-  const auto inserted = this->StrokeBefore.try_emplace(brickId);
-  if (!inserted.second)
-  {
-    return;
-  }
-  BrickValues& values = inserted.first->second;
-  if (brick)
-  {
-    values.resize(SamplesPerBrick);
-    for (int index = 0; index < SamplesPerBrick; ++index)
-    {
-      values[index] = brick->Values[index].load(std::memory_order_relaxed);
-    }
-  }
-  this->StrokeBeforeMemory += UndoStep::EntryMemory(values);
-}
-
 
 //------------------------------------------------------------------------------
 bool vtkVolumeCutField::CutToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1)
@@ -784,15 +674,15 @@ void vtkVolumeCutField::ApplyWithinStroke(const DistanceSource& source, Writer&&
   {
     return; // wholly outside the volume: nothing to do
   }
-  const bool ownStroke = !this->StrokeOpen;
+  const bool ownStroke = !this->History->IsStrokeOpen();
   if (ownStroke)
   {
-    this->BeginStroke();
+    this->History->BeginStroke();
   }
   const bool anyChange = write(lower, upper);
   if (ownStroke)
   {
-    this->EndStroke();
+    this->History->EndStroke();
   }
   if (anyChange)
   {
@@ -884,12 +774,12 @@ bool vtkVolumeCutField::MergeSegment(const Brick* brick, const vtkVolumeCutProte
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::CommitBrick(vtkIdType brickId, Brick* brick, const int16_t* merged, const ChangedRun* runs, int runCount)
 {
-  this->RememberBrickBeforeChange(brickId, brick);
+  this->History->RememberBrickBeforeChange(brickId, brick);
   if (!brick)
   {
     brick = this->GetOrCreateBrick(brickId);
   }
-  brick->RememberedInStroke = this->StrokeSerial;
+  brick->RememberedInStroke = this->History->GetStrokeSerial();
   // Seqlock write: readers that overlap it see an odd or changed sequence and retry.
   const uint32_t sequence = brick->Sequence.load(std::memory_order_relaxed);
   brick->Sequence.store(sequence + 1, std::memory_order_relaxed);
@@ -1168,66 +1058,41 @@ bool vtkVolumeCutField::ApplyBrickwise(const BrickDistanceSource& source, Operat
   return anyChange;
 }
 
+
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::BeginStroke()
 {
-  if (this->StrokeOpen)
-  {
-    return;
-  }
-  this->StrokeOpen = true;
-  ++this->StrokeSerial;
-  this->StrokeBefore.clear();
-  this->StrokeBeforeMemory = 0;
+  this->History->BeginStroke();
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutField::EndStroke()
 {
-  if (!this->StrokeOpen)
-  {
-    return;
-  }
-  this->StrokeOpen = false;
-  if (this->StrokeBefore.empty())
-  {
-    return;
-  }
-  // Handed over whole, copying nothing: the haptic thread may close strokes.
-  UndoStep step;
-  step.Before.swap(this->StrokeBefore);
-  step.Memory = this->StrokeBeforeMemory;
-  this->StrokeBeforeMemory = 0;
-  this->RedoStack.clear();
-  this->PushUndoStep(std::move(step));
+  this->History->EndStroke();
 }
 
 //------------------------------------------------------------------------------
-void vtkVolumeCutField::PushUndoStep(UndoStep&& step)
+bool vtkVolumeCutField::IsStrokeOpen() const
 {
-  const size_t stepSize = step.MemorySize();
-  if (stepSize > this->UndoMemoryBudget)
-  {
-    vtkErrorMacro("EndStroke: this stroke changed " << stepSize / 1024 << " KiB of the cut field, more than the undo budget of "
-                                                    << this->UndoMemoryBudget / 1024 << " KiB; it cannot be undone, and older steps are dropped");
-    this->UndoStack.clear();
-    this->UndoMemorySize = 0;
-    return;
-  }
-  int dropped = 0;
-  while (!this->UndoStack.empty() && this->UndoMemorySize + stepSize > this->UndoMemoryBudget)
-  {
-    this->UndoMemorySize -= this->UndoStack.front().MemorySize();
-    this->UndoStack.erase(this->UndoStack.begin());
-    ++dropped;
-  }
-  if (dropped > 0)
-  {
-    vtkWarningMacro("EndStroke: the undo history reached its budget of " << this->UndoMemoryBudget / 1024 << " KiB; the oldest " << dropped
-                                                                         << " step(s) can no longer be undone");
-  }
-  this->UndoMemorySize += stepSize;
-  this->UndoStack.push_back(std::move(step));
+  return this->History->IsStrokeOpen();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::Undo()
+{
+  return this->History->Undo();
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::Redo()
+{
+  return this->History->Redo();
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutField::GetUndoMemorySize() const
+{
+  return this->History->GetMemorySize();
 }
 
 //------------------------------------------------------------------------------
@@ -1255,50 +1120,6 @@ void vtkVolumeCutField::WriteBricks(const BrickStates& bricks)
   this->Modified();
 }
 
-//------------------------------------------------------------------------------
-bool vtkVolumeCutField::Undo()
-{
-  this->EndStroke();
-  if (this->UndoStack.empty())
-  {
-    vtkErrorMacro("Undo: there is no stroke to undo");
-    return false;
-  }
-  UndoStep step = std::move(this->UndoStack.back());
-  this->UndoStack.pop_back();
-  this->UndoMemorySize -= step.MemorySize();
-  // The field holds the state after this step: keep it for a redo.
-  step.After.clear();
-  for (const auto& entry : step.Before)
-  {
-    BrickValues& after = step.After[entry.first];
-    after.resize(SamplesPerBrick);
-    this->CopyBrick(entry.first, after.data());
-  }
-  step.CountMemory();
-  this->WriteBricks(step.Before);
-  this->RedoStack.push_back(std::move(step));
-  return true;
-}
-
-//------------------------------------------------------------------------------
-bool vtkVolumeCutField::Redo()
-{
-  this->EndStroke();
-  if (this->RedoStack.empty())
-  {
-    vtkErrorMacro("Redo: there is no stroke to redo");
-    return false;
-  }
-  UndoStep step = std::move(this->RedoStack.back());
-  this->RedoStack.pop_back();
-  this->WriteBricks(step.After);
-  step.After.clear(); // read back again by the next undo
-  step.CountMemory();
-  this->UndoMemorySize += step.MemorySize();
-  this->UndoStack.push_back(std::move(step));
-  return true;
-}
 
 //------------------------------------------------------------------------------
 int16_t vtkVolumeCutField::ReadSample(int i, int j, int k) const
@@ -1762,7 +1583,8 @@ void vtkVolumeCutField::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaximumStrokeLength: " << this->MaximumStrokeLength << "\n";
   os << indent << "InstructionSet: " << GetInstructionSetAsString(GetInstructionSet()) << "\n";
   os << indent << "NumberOfAllocatedBricks: " << this->GetNumberOfAllocatedBricks() << "\n";
-  os << indent << "UndoSteps: " << this->UndoStack.size() << " (" << this->UndoMemorySize / 1024 << " KiB of " << this->UndoMemoryBudget / 1024
+  os << indent << "UndoSteps: " << this->History->GetNumberOfUndoSteps() << " (" << this->History->GetMemorySize() / 1024 << " KiB of "
+     << this->UndoMemoryBudget / 1024
      << " KiB)\n";
 }
 
@@ -1853,10 +1675,8 @@ void vtkVolumeCutField::GetBrickIndex(vtkIdType brickId, int index[3]) const
 void vtkVolumeCutField::ReplaceBricks(const BrickStates& bricks)
 {
   // A field made from another has its own history, starting now.
-  this->EndStroke();
-  this->UndoStack.clear();
-  this->RedoStack.clear();
-  this->UndoMemorySize = 0;
+  this->History->EndStroke();
+  this->History->Clear();
   this->LastCapsule.Valid = false;
   this->LastToolSweep.Valid = false;
   this->WriteBricks(bricks);
