@@ -36,13 +36,13 @@
 
 #include "vtkObject.h"
 #include "vtkType.h" // For vtkTypeUInt64
-#include "vtkSmartPointer.h"              // For the protection
+#include "vtkSmartPointer.h"              // For the protection and the undo history
 #include "vtkVolumeCutProtection.h"     // For the protection
 #include "vtkVolumeCuttingCoreExport.h" // For export macro
 
 #include <atomic>  // For the brick directory
 #include <cstdint> // For int16_t
-#include <map>     // For the open stroke
+#include <map>     // For BrickStates
 #include <memory>  // For std::unique_ptr
 #include <vector>  // For the brick directory
 
@@ -52,6 +52,7 @@ class vtkIdTypeArray;
 class vtkImageData;
 class vtkMatrix4x4;
 class vtkPolyData;
+class vtkVolumeCutFieldUndoHistory;
 class vtkVolumeCutTool;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutField : public vtkObject
@@ -182,7 +183,7 @@ public:
    */
   void BeginStroke();
   void EndStroke();
-  bool IsStrokeOpen() const { return this->StrokeOpen; }
+  bool IsStrokeOpen() const;
   ///@}
 
   ///@{
@@ -205,7 +206,7 @@ public:
    */
   vtkSetMacro(UndoMemoryBudget, size_t);
   vtkGetMacro(UndoMemoryBudget, size_t);
-  size_t GetUndoMemorySize() const { return this->UndoMemorySize; }
+  size_t GetUndoMemorySize() const;
   ///@}
 
   /**
@@ -407,7 +408,6 @@ public:
   struct BrickDistanceSource;
 
 protected:
-  struct UndoStep;
   enum class Operation
   {
     Cut,
@@ -451,8 +451,6 @@ protected:
   bool ApplyToolSweep(vtkVolumeCutTool* tool, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, Operation operation);
   bool ValidateStroke(const double p0[3], const double p1[3], double radius, const char* caller) const;
   Brick* GetOrCreateBrick(vtkIdType brickId);
-  void RememberBrickBeforeChange(vtkIdType brickId, const Brick* brick);
-  void PushUndoStep(UndoStep&& step);
   void WriteBricks(const BrickStates& bricks);
   /// Write bricks as the whole new content of a field made from another (no history).
   void ReplaceBricks(const BrickStates& bricks);
@@ -521,7 +519,6 @@ protected:
   double AnatomyIJKToRAS[16];
   double RASToSubIJK[4][4];
   size_t UndoMemoryBudget = 256u << 20;
-  size_t UndoMemorySize = 0;
 
   std::unique_ptr<std::atomic<Brick*>[]> Directory;
   // Allocated brick IDs in allocation order; readers see the first
@@ -541,19 +538,14 @@ protected:
   // SamplesPerBrick long) and the radius of a ball about its centre holding them.
   std::vector<float> BrickSampleOffsets;
   double BrickBoundingRadius = 0.0;
-  bool StrokeOpen = false;
-  // Bricks touched by the open stroke: their values before it began.
-  BrickStates StrokeBefore;
-  size_t StrokeBeforeMemory = 0;
-  /// Counts the strokes begun: a brick remembered in this one carries its number.
-  vtkTypeUInt64 StrokeSerial = 0;
   std::atomic<vtkTypeUInt64> StampCounter{ 0 };
-  std::vector<UndoStep> UndoStack;
-  std::vector<UndoStep> RedoStack;
+  /// The strokes that can be undone and redone, and the open one.
+  vtkSmartPointer<vtkVolumeCutFieldUndoHistory> History;
 
 private:
   friend class vtkVolumeCutMaterialRemoval;
   friend class vtkVolumeCutFieldFile;
+  friend class vtkVolumeCutFieldUndoHistory;
   vtkVolumeCutField(const vtkVolumeCutField&) = delete;
   void operator=(const vtkVolumeCutField&) = delete;
 };
