@@ -273,7 +273,7 @@ protected:
 
   /// The removed fraction of each anatomy voxel (see
   /// vtkVolumeCutField::ExportRemovedFraction), computed once per change of the
-  /// field and shared by the per-segment volumes and the exports.
+  /// field and shared by the exports of the removed region and fraction.
   vtkImageData* GetRemovedFraction(vtkMRMLVolumeCutNode* cutNode);
 
   /// Removed fractions by cut-node ID, with the field modification time they match.
