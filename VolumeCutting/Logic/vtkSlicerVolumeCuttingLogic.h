@@ -32,6 +32,7 @@ class vtkMRMLTableNode;
 class vtkFloatArray;
 class vtkIdTypeArray;
 class vtkSlicerVolumeCuttingSegmentLayers;
+class vtkSlicerVolumeCuttingToolCache;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
@@ -49,6 +50,14 @@ class vtkMRMLVolumeCutToolNode;
 /// vtkVolumeCuttingCore library, and this class connects them to MRML nodes.
 /// Any source of work (the module widget, a Python script, a replay) uses the
 /// same methods, so they are tested without a GUI.
+///
+/// Its implementation is split by responsibility: node registration, scene
+/// observation and input checks (vtkSlicerVolumeCuttingLogic.cxx); the cut
+/// field of a node, its grid and its shield (...LogicCutField.cxx); strokes
+/// and tool motion (...LogicStrokes.cxx); removed volume, tables and exports
+/// (...LogicResults.cxx). Helpers that need no per-node state are classes of
+/// their own: vtkSlicerVolumeCuttingToolCache, vtkSlicerVolumeCuttingSegmentImages,
+/// vtkSlicerVolumeCuttingTables and vtkSlicerVolumeCuttingExporter.
 class VTK_SLICER_VOLUMECUTTING_MODULE_LOGIC_EXPORT vtkSlicerVolumeCuttingLogic : public vtkSlicerModuleLogic
 {
 public:
@@ -264,11 +273,8 @@ protected:
 
   /// The removed fraction of each anatomy voxel (see
   /// vtkVolumeCutField::ExportRemovedFraction), computed once per change of the
-  /// field and shared by the per-segment volumes and the exports.
+  /// field and shared by the exports of the removed region and fraction.
   vtkImageData* GetRemovedFraction(vtkMRMLVolumeCutNode* cutNode);
-
-  /// Add a scalar volume holding \a image on the anatomy's voxel grid.
-  vtkMRMLScalarVolumeNode* AddVolumeOnAnatomyGrid(vtkMRMLScalarVolumeNode* anatomy, vtkImageData* image, const std::string& name);
 
   /// Removed fractions by cut-node ID, with the field modification time they match.
   std::map<std::string, std::pair<vtkMTimeType, vtkSmartPointer<vtkImageData>>> RemovedFractions;
@@ -293,10 +299,6 @@ protected:
   /// layers (a table change only, when the segmentation did not change).
   void UpdateProtection(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field, bool force = false);
 
-  /// What differs between the field's grid and the anatomy's ("" if nothing,
-  /// to a thousandth of a voxel).
-  static std::string DescribeGridChange(vtkVolumeCutField* field, const int anatomyDimensions[3], vtkMatrix4x4* anatomyIJKToRAS, int factor);
-
   /// The segmentation's layers on the anatomy grid, per cut-node ID.
   vtkSlicerVolumeCuttingSegmentLayers* GetSegmentLayers(vtkMRMLVolumeCutNode* cutNode);
   std::map<std::string, vtkSmartPointer<vtkSlicerVolumeCuttingSegmentLayers>> SegmentLayers;
@@ -315,13 +317,11 @@ protected:
   std::map<std::string, double> ReportedContactDepths;
   /// Add a row to the contact table if the stroke that ends touched a shielded segment.
   void RecordContact(vtkMRMLVolumeCutNode* cutNode, vtkVolumeCutField* field);
-  /// A table referenced by the cut node under a role, created with its columns on first use.
-  vtkMRMLTableNode* GetReferencedTable(vtkMRMLVolumeCutNode* cutNode, const char* role, const char* nameSuffix, const std::vector<std::string>& columns);
 
   /// Sweep the active tool between two poses (cut or restore).
   bool SweepActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, bool cut);
-  /// Cutting tools by tool-node ID, with the node modification time they match.
-  std::map<std::string, std::pair<vtkMTimeType, vtkSmartPointer<vtkVolumeCutTool>>> CuttingTools;
+  /// Cutting tools of the tool nodes, built once per change of a tool node.
+  vtkSmartPointer<vtkSlicerVolumeCuttingToolCache> ToolCache;
   /// The active tool's last pose in the open stroke, per cut-node ID.
   std::map<std::string, vtkSmartPointer<vtkMatrix4x4>> StrokePoses;
 

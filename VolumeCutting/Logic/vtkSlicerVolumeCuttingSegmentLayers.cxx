@@ -10,6 +10,9 @@
 
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
 
+// VolumeCutting includes
+#include "vtkVolumeCutRemovedVoxels.h"
+
 // SegmentationCore includes
 #include <vtkOrientedImageData.h>
 #include <vtkOrientedImageDataResample.h>
@@ -223,6 +226,57 @@ bool vtkSlicerVolumeCuttingSegmentLayers::IsInSegment(int layer, int labelValue,
     return false;
   }
   return static_cast<int>(image->GetScalarComponentAsDouble(i, j, k, 0)) == labelValue;
+}
+
+//----------------------------------------------------------------------------
+std::map<std::string, double> vtkSlicerVolumeCuttingSegmentLayers::SumRemovedFractions(
+  vtkVolumeCutRemovedVoxels* voxels, const int anatomyDimensions[3], const std::vector<std::string>& segmentIds) const
+{
+  std::map<std::string, double> sums;
+  if (!voxels)
+  {
+    return sums;
+  }
+  // Which segments each (layer, value) stands for.
+  std::vector<std::map<int, std::vector<std::string>>> byValue(static_cast<size_t>(this->GetNumberOfLayers()));
+  for (const std::string& segmentId : segmentIds)
+  {
+    int value = 0;
+    const int layer = this->GetSegmentLayer(segmentId, value);
+    if (layer >= 0)
+    {
+      byValue[layer][value].push_back(segmentId);
+      sums[segmentId] = 0.0;
+    }
+  }
+  const int* dims = anatomyDimensions;
+  voxels->ForEachVoxel([&](vtkIdType id, float fraction) {
+    const int i = static_cast<int>(id % dims[0]);
+    const int j = static_cast<int>((id / dims[0]) % dims[1]);
+    const int k = static_cast<int>(id / (static_cast<vtkIdType>(dims[0]) * dims[1]));
+    for (int layer = 0; layer < this->GetNumberOfLayers(); ++layer)
+    {
+      if (byValue[layer].empty())
+      {
+        continue;
+      }
+      vtkImageData* image = this->GetLayer(layer);
+      const int* extent = image->GetExtent();
+      if (i < extent[0] || i > extent[1] || j < extent[2] || j > extent[3] || k < extent[4] || k > extent[5])
+      {
+        continue;
+      }
+      auto found = byValue[layer].find(static_cast<int>(image->GetScalarComponentAsDouble(i, j, k, 0)));
+      if (found != byValue[layer].end())
+      {
+        for (const std::string& segmentId : found->second)
+        {
+          sums[segmentId] += fraction;
+        }
+      }
+    }
+  });
+  return sums;
 }
 
 //----------------------------------------------------------------------------

@@ -26,6 +26,7 @@
 class vtkImageData;
 class vtkMatrix4x4;
 class vtkSegmentation;
+class vtkVolumeCutRemovedVoxels;
 
 /// \brief A segmentation's labelmap layers on an anatomy's voxel grid, without copies.
 ///
@@ -65,6 +66,15 @@ public:
 
   /// Whether a segment's layer holds its value at anatomy voxel (i, j, k).
   bool IsInSegment(int layer, int labelValue, int i, int j, int k) const;
+
+#ifndef __VTK_WRAP__
+  /// The removed fractions of a cut's voxels summed per segment, in voxels
+  /// (times the voxel volume, mm^3): one read per layer and removed voxel,
+  /// whatever the number of segments. Segments without a labelmap are left
+  /// out of the result; the others start at 0.
+  std::map<std::string, double> SumRemovedFractions(vtkVolumeCutRemovedVoxels* voxels, const int anatomyDimensions[3],
+                                                    const std::vector<std::string>& segmentIds) const;
+#endif
 
   /// The grid offset (anatomy IJK of the image's voxel 0) of an image with the
   /// given image-to-world matrix, when it lies on the anatomy grid.

@@ -6,8 +6,10 @@
 #include "vtkFloatArray.h"
 #include "vtkIdList.h"
 #include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
+#include "vtkPointData.h"
 
 #include <unordered_set>
 
@@ -131,6 +133,40 @@ double vtkVolumeCutRemovedVoxels::GetTotalFraction() const
   double total = 0.0;
   this->ForEachVoxel([&](vtkIdType, float fraction) { total += fraction; });
   return total;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutRemovedVoxels::ExportFraction(const int anatomyDimensions[3], vtkImageData* fraction) const
+{
+  if (!fraction)
+  {
+    return;
+  }
+  fraction->SetDimensions(anatomyDimensions[0], anatomyDimensions[1], anatomyDimensions[2]);
+  fraction->AllocateScalars(VTK_FLOAT, 1);
+  vtkFloatArray* scalars = vtkFloatArray::SafeDownCast(fraction->GetPointData()->GetScalars());
+  scalars->SetName("RemovedFraction");
+  scalars->FillValue(0.0f);
+  float* values = scalars->GetPointer(0);
+  this->ForEachVoxel([values](vtkIdType id, float removed) { values[id] = removed; });
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutRemovedVoxels::BlendTowards(vtkImageData* anatomy, double fillValue) const
+{
+  vtkDataArray* voxels = anatomy ? anatomy->GetPointData()->GetScalars() : nullptr;
+  if (!voxels)
+  {
+    return;
+  }
+  const vtkIdType voxelCount = anatomy->GetNumberOfPoints();
+  this->ForEachVoxel([&](vtkIdType id, float removed) {
+    if (removed > 0.0f && id < voxelCount)
+    {
+      const double value = voxels->GetComponent(id, 0);
+      voxels->SetComponent(id, 0, value + removed * (fillValue - value));
+    }
+  });
 }
 
 //------------------------------------------------------------------------------

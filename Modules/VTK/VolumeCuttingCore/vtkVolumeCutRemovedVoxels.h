@@ -28,6 +28,7 @@
 
 class vtkFloatArray;
 class vtkIdTypeArray;
+class vtkImageData;
 class vtkVolumeCutField;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutRemovedVoxels : public vtkObject
@@ -49,6 +50,21 @@ public:
   vtkIdType GetNumberOfVoxels() const;
   /// Sum of the fractions (voxels); times the voxel volume, the removed volume.
   double GetTotalFraction() const;
+
+  /**
+   * The removed fraction of every anatomy voxel as a dense float image of the
+   * anatomy's dimensions (IJK geometry, scalars named "RemovedFraction", 0
+   * where nothing was removed): the fractional labelmap of the removed region.
+   */
+  void ExportFraction(const int anatomyDimensions[3], vtkImageData* fraction) const;
+
+  /**
+   * Blend each removed voxel of an anatomy image (its first component) towards
+   * fillValue by the voxel's removed fraction: fully removed voxels take
+   * fillValue, partly removed ones keep partial volume. Only the cut's voxels
+   * are visited.
+   */
+  void BlendTowards(vtkImageData* anatomy, double fillValue) const;
 
 #ifndef __VTK_WRAP__
   /// For each removed voxel: visit(anatomyVoxelId, fraction).

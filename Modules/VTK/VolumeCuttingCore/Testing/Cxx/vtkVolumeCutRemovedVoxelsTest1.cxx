@@ -128,6 +128,32 @@ int vtkVolumeCutRemovedVoxelsTest1(int, char*[])
   field->CutCapsule(p0, p1, 2.5);
   CHECK_EXIT_SUCCESS(CheckAgainstFullExport(tally, field, "after a stroke into the shield"));
 
+  // The dense fraction and the drilled image hold the tally's voxels, nothing else.
+  vtkNew<vtkIdTypeArray> ids;
+  vtkNew<vtkFloatArray> fractions;
+  tally->GetVoxels(ids, fractions);
+  const std::map<vtkIdType, float> removed = AsMap(ids, fractions);
+  vtkNew<vtkImageData> dense;
+  tally->ExportFraction(dims, dense);
+  CHECK_INT(static_cast<int>(dense->GetNumberOfPoints()), dims[0] * dims[1] * dims[2]);
+  CHECK_STRING(dense->GetPointData()->GetScalars()->GetName(), "RemovedFraction");
+  vtkNew<vtkImageData> drilled;
+  drilled->SetDimensions(dims[0], dims[1], dims[2]);
+  drilled->AllocateScalars(VTK_SHORT, 1);
+  drilled->GetPointData()->GetScalars()->FillComponent(0, 100.0);
+  tally->BlendTowards(drilled, -1000.0);
+  vtkFloatArray* denseValues = vtkFloatArray::SafeDownCast(dense->GetPointData()->GetScalars());
+  vtkDataArray* drilledValues = drilled->GetPointData()->GetScalars();
+  int differing = 0;
+  for (vtkIdType id = 0; id < dense->GetNumberOfPoints(); ++id)
+  {
+    auto found = removed.find(id);
+    const float fraction = found != removed.end() ? found->second : 0.0f;
+    const double blended = static_cast<short>(100.0 + fraction * (-1000.0 - 100.0));
+    differing += denseValues->GetValue(id) != fraction || drilledValues->GetComponent(id, 0) != blended;
+  }
+  CHECK_INT(differing, 0);
+
   // Another field starts the tally over.
   vtkNew<vtkVolumeCutField> other;
   CHECK_BOOL(other->Initialize(dims, ijkToRas, 1), true);

@@ -1,0 +1,155 @@
+/*==============================================================================
+
+  VolumeCutting: virtual bone drilling and volume cutting for 3D Slicer.
+
+  Licensed under the Apache License, Version 2.0 (the "License");
+  you may not use this file except in compliance with the License.
+  You may obtain a copy of the License at http://www.apache.org/licenses/LICENSE-2.0
+
+==============================================================================*/
+
+#include "vtkSlicerVolumeCuttingSegmentImages.h"
+
+// MRML includes
+#include <vtkMRMLScalarVolumeNode.h>
+#include <vtkMRMLSegmentationNode.h>
+
+// SegmentationCore includes
+#include <vtkOrientedImageData.h>
+#include <vtkOrientedImageDataResample.h>
+#include <vtkSegment.h>
+#include <vtkSegmentation.h>
+#include <vtkSegmentationConverter.h>
+
+// VTK includes
+#include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
+#include <vtkImageData.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+
+// STD includes
+#include <algorithm>
+
+vtkStandardNewMacro(vtkSlicerVolumeCuttingSegmentImages);
+
+//----------------------------------------------------------------------------
+vtkSlicerVolumeCuttingSegmentImages::vtkSlicerVolumeCuttingSegmentImages() = default;
+
+//----------------------------------------------------------------------------
+vtkSlicerVolumeCuttingSegmentImages::~vtkSlicerVolumeCuttingSegmentImages() = default;
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingSegmentImages::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingSegmentImages::GetAnatomyGeometry(vtkMRMLScalarVolumeNode* anatomy, vtkOrientedImageData* geometry)
+{
+  vtkNew<vtkMatrix4x4> ijkToRas;
+  anatomy->GetIJKToRASMatrix(ijkToRas);
+  geometry->SetImageToWorldMatrix(ijkToRas);
+  geometry->SetExtent(anatomy->GetImageData()->GetExtent());
+}
+
+//----------------------------------------------------------------------------
+std::vector<std::string> vtkSlicerVolumeCuttingSegmentImages::CreateLabelMap(
+  vtkMRMLScalarVolumeNode* anatomy, vtkMRMLSegmentationNode* segmentationNode, const std::vector<std::string>& segmentIds, vtkImageData* labels)
+{
+  std::vector<std::string> missing;
+  if (!labels || !anatomy || !anatomy->GetImageData())
+  {
+    return segmentIds;
+  }
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  GetAnatomyGeometry(anatomy, anatomyGeometry);
+  labels->Initialize();
+  labels->SetExtent(anatomy->GetImageData()->GetExtent());
+  labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
+  labels->GetPointData()->GetScalars()->FillComponent(0, 0.0);
+  unsigned short* labelVoxels = static_cast<unsigned short*>(labels->GetScalarPointer());
+  const int* dims = labels->GetDimensions();
+  for (size_t index = 0; index < segmentIds.size(); ++index)
+  {
+    vtkNew<vtkOrientedImageData> segmentMask;
+    vtkNew<vtkOrientedImageData> mask;
+    if (index >= 65535 || !segmentationNode || !segmentationNode->GetSegmentation()->GetSegment(segmentIds[index]) ||
+      !segmentationNode->GetBinaryLabelmapRepresentation(segmentIds[index], segmentMask) ||
+      !vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(segmentMask, anatomyGeometry, mask))
+    {
+      missing.push_back(segmentIds[index]);
+      continue;
+    }
+    int extent[6];
+    mask->GetExtent(extent);
+    for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+    {
+      for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+      {
+        for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
+        {
+          if (mask->GetScalarComponentAsDouble(i, j, k, 0) > 0.0)
+          {
+            labelVoxels[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<unsigned short>(index + 1);
+          }
+        }
+      }
+    }
+  }
+  return missing;
+}
+
+//----------------------------------------------------------------------------
+bool vtkSlicerVolumeCuttingSegmentImages::CreateFraction(
+  vtkMRMLScalarVolumeNode* anatomy, vtkMRMLSegmentationNode* segmentationNode, const std::string& segmentId, vtkImageData* fraction)
+{
+  const std::string name = vtkSegmentationConverter::GetSegmentationFractionalLabelmapRepresentationName();
+  vtkSegment* segment = segmentationNode ? segmentationNode->GetSegmentation()->GetSegment(segmentId) : nullptr;
+  vtkOrientedImageData* source = segment ? vtkOrientedImageData::SafeDownCast(segment->GetRepresentation(name)) : nullptr;
+  if (!fraction || !anatomy || !anatomy->GetImageData() || !source || !source->GetPointData()->GetScalars())
+  {
+    return false;
+  }
+  vtkNew<vtkOrientedImageData> anatomyGeometry;
+  GetAnatomyGeometry(anatomy, anatomyGeometry);
+  vtkNew<vtkOrientedImageData> resampled;
+  // Linear: the fractions of a segment resampled stay fractions.
+  if (!vtkOrientedImageDataResample::ResampleOrientedImageToReferenceOrientedImage(source, anatomyGeometry, resampled, true))
+  {
+    return false;
+  }
+  // Slicer stores fractions as [minimum, maximum] of the representation's
+  // scalar range (-108..108 for its char labelmaps); padding is outside.
+  double range[2] = { -108.0, 108.0 };
+  vtkDoubleArray* scalarRange = vtkDoubleArray::SafeDownCast(
+    source->GetFieldData()->GetAbstractArray(vtkSegmentationConverter::GetScalarRangeFieldName()));
+  if (scalarRange && scalarRange->GetNumberOfValues() == 2)
+  {
+    range[0] = scalarRange->GetValue(0);
+    range[1] = scalarRange->GetValue(1);
+  }
+  fraction->Initialize();
+  fraction->SetExtent(anatomy->GetImageData()->GetExtent());
+  fraction->AllocateScalars(VTK_FLOAT, 1);
+  fraction->GetPointData()->GetScalars()->FillComponent(0, 0.0);
+  float* values = static_cast<float*>(fraction->GetScalarPointer());
+  const int* dims = fraction->GetDimensions();
+  int extent[6];
+  resampled->GetExtent(extent);
+  for (int k = std::max(extent[4], 0); k <= std::min(extent[5], dims[2] - 1); ++k)
+  {
+    for (int j = std::max(extent[2], 0); j <= std::min(extent[3], dims[1] - 1); ++j)
+    {
+      for (int i = std::max(extent[0], 0); i <= std::min(extent[1], dims[0] - 1); ++i)
+      {
+        const double value = (resampled->GetScalarComponentAsDouble(i, j, k, 0) - range[0]) / (range[1] - range[0]);
+        values[(static_cast<vtkIdType>(k) * dims[1] + j) * dims[0] + i] = static_cast<float>(std::min(1.0, std::max(0.0, value)));
+      }
+    }
+  }
+  return true;
+}
