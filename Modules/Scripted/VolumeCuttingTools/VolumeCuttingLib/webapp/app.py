@@ -623,11 +623,22 @@ class VolumeCuttingApp(TrameApp):
             if self.progressive is not None:
                 self.progressive.pointer_moved()
 
+        @ctrl.trigger("vc_set_mode")
+        def set_mode(mode):
+            # The mode buttons call this at the click. A state change would wait in the page while any
+            # call to the server is unanswered (trame's client pushes state only when not busy), and a
+            # press right after the click, sent at once by the view, would reach the server first and be
+            # taken in the old mode: after a camera rotation the server refines the view for a second or
+            # two, and the first drag after "Drill" did nothing.
+            mode_changed(mode)
+
         @state.change("vc_mode")
         def mode_changed(vc_mode, **_):
             try:
                 self.drill.set_mode(vc_mode)
             except ValueError:
+                pass
+            if state.vc_mode != self.drill.mode:
                 state.vc_mode = self.drill.mode
             # The outline lies on the skin; drilling shows the bone.
             if self.drill.mode == views.MODE_OUTLINE:
@@ -813,10 +824,10 @@ class VolumeCuttingApp(TrameApp):
                 v3.VSpacer()
                 with v3.VBtnToggle(v_model=("vc_mode",), mandatory=True, density="compact", classes="mr-2",
                                    raw_attrs=['data-testid="mode"']):
-                    v3.VBtn("Navigate", value=views.MODE_NAVIGATE, prepend_icon="mdi-rotate-3d-variant", raw_attrs=['data-testid="mode-navigate"'])
-                    v3.VBtn("Drill", value=views.MODE_DRILL, prepend_icon="mdi-screw-machine-flat-top", raw_attrs=['data-testid="mode-drill"'])
-                    v3.VBtn("Restore", value=views.MODE_RESTORE, prepend_icon="mdi-bandage", raw_attrs=['data-testid="mode-restore"'])
-                    v3.VBtn("SoftCut outline", value=views.MODE_OUTLINE, prepend_icon="mdi-vector-polygon",
+                    v3.VBtn("Navigate", value=views.MODE_NAVIGATE, click=f"trigger('vc_set_mode', ['{views.MODE_NAVIGATE}'])", prepend_icon="mdi-rotate-3d-variant", raw_attrs=['data-testid="mode-navigate"'])
+                    v3.VBtn("Drill", value=views.MODE_DRILL, click=f"trigger('vc_set_mode', ['{views.MODE_DRILL}'])", prepend_icon="mdi-screw-machine-flat-top", raw_attrs=['data-testid="mode-drill"'])
+                    v3.VBtn("Restore", value=views.MODE_RESTORE, click=f"trigger('vc_set_mode', ['{views.MODE_RESTORE}'])", prepend_icon="mdi-bandage", raw_attrs=['data-testid="mode-restore"'])
+                    v3.VBtn("SoftCut outline", value=views.MODE_OUTLINE, click=f"trigger('vc_set_mode', ['{views.MODE_OUTLINE}'])", prepend_icon="mdi-vector-polygon",
                             raw_attrs=['data-testid="mode-outline"'])
                 v3.VBtn(icon="mdi-undo", click="trigger('vc_undo')", disabled=("vc_undo_count === 0",), raw_attrs=['data-testid="undo"'])
                 v3.VBtn(icon="mdi-redo", click="trigger('vc_redo')", disabled=("vc_redo_count === 0",), raw_attrs=['data-testid="redo"'])

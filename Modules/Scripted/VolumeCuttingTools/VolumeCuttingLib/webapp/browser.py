@@ -242,10 +242,23 @@ class AppPage:
         return float(text.split(":")[1].split()[0])
 
     def wait_for(self, script: str, timeout_s: float = 30.0, what: str = "", arg=None):
-        try:
-            return self.page.wait_for_function(script, arg=arg, timeout=timeout_s * 1000)
-        except Exception as error:  # Playwright's TimeoutError
-            raise BrowserTestError(f"Waited {timeout_s:.0f} s for {what or script}: {error}") from error
+        """Until the function ``script`` returns a truthy value; a function that returns a promise is awaited.
+
+        Playwright's wait_for_function takes a pending promise for a truthy answer, so an ``async`` predicate
+        (a trigger asking the server) returned at once: polled here with evaluate, which awaits it.
+        """
+        deadline = time.monotonic() + timeout_s
+        while True:
+            try:
+                # Only truthiness crosses back: a predicate may return a DOM element, which does not serialize.
+                value = self.page.evaluate(f"async (arg) => !!(await ({script})(arg))", arg)
+            except Exception as error:  # the page navigating, a script error: report it with what was awaited
+                raise BrowserTestError(f"Waiting for {what or script}: {error}") from error
+            if value:
+                return value
+            if time.monotonic() > deadline:
+                raise BrowserTestError(f"Waited {timeout_s:.0f} s for {what or script}")
+            self.page.wait_for_timeout(50)
 
     def wait_for_total_removed(self, predicate: str, timeout_s: float = 30.0) -> float:
         """Until the total removed volume (mm3, a number ``v``) satisfies ``predicate`` (JavaScript, e.g. 'v > 0')."""
