@@ -243,6 +243,10 @@ class VolumeCuttingApp(TrameApp):
                             "background: #d50000; color: white; padding: 6px 14px; border-radius: 4px; "
                             "font-weight: 600; pointer-events: none;"):
             html.Span("{{ vc_contact }}")
+            v3.VBtn("Make {{ vc_contact_fix && vc_contact_fix.name }} cuttable", v_if="vc_contact_fix", size="small",
+                    variant="outlined", color="white", classes="ml-3", style="pointer-events: auto;",
+                    click="trigger('vc_set_role', [vc_contact_fix.id, 'cuttable']); vc_contact = ''; vc_contact_fix = null",
+                    raw_attrs=['data-testid="make-cuttable"'])
         html.Div("{{ vc_mode_hint }}", style="position: absolute; bottom: 8px; left: 12px; z-index: 2; color: white; "
                  "text-shadow: 0 0 3px black; pointer-events: none; font-size: 13px;")
 
@@ -329,7 +333,7 @@ class VolumeCuttingApp(TrameApp):
             "vc_tool": {}, "vc_tool_error": "", "vc_tool_ranges": self._tool_ranges("Sphere"),
             "vc_mode": self.drill.mode, "vc_mode_hint": "", "vc_depth": self.drill.depth_mm,
             "vc_undo_count": 0, "vc_redo_count": 0,
-            "vc_contact": "", "vc_contacts": [],
+            "vc_contact": "", "vc_contact_fix": None, "vc_contacts": [],
             "vc_export_error": "", "vc_export_names": {},
             "vc_owner": "", "vc_client_id": "",
             "vc_sc_points": 0, "vc_sc_example": False, "vc_sc_normal": self.softcut.normal_mode,
@@ -352,7 +356,7 @@ class VolumeCuttingApp(TrameApp):
         self.state.vc_warnings = list(self.session.warnings)
         base = "".join(c if c.isalnum() or c in "-_" else "_" for c in self.session.volume.GetName()) or "volume"
         self.state.vc_export_names = {kind: f"{base}-{name}" for kind, (name, _) in EXPORT_FILES.items()}
-        self.state.vc_contact = ""
+        self.state.vc_contact, self.state.vc_contact_fix = "", None
         self.state.vc_sc_export_name = f"{base}-resection.stl"
         self._refresh_tool()
         self._refresh_tables()
@@ -403,8 +407,16 @@ class VolumeCuttingApp(TrameApp):
         contact = self.session.contact()
         if contact is None:
             return
-        self.state.vc_contact = (f"Contact with {contact.name} ({'protected' if self.session.cut_node.IsSegmentProtected(contact.segment_id) else 'not cuttable by this tool'}): "
-                                 f"{contact.depth_mm:.2f} mm deep")
+        protected = self.session.cut_node.IsSegmentProtected(contact.segment_id)
+        if protected:
+            self.state.vc_contact = f"Contact with {contact.name} (protected): {contact.depth_mm:.2f} mm deep"
+            self.state.vc_contact_fix = None
+        else:
+            # A role-less segment (every segment of a labelmap starts so) stops the burr like a protected
+            # one; a newcomer needs the way forward, not only the reason.
+            self.state.vc_contact = (f"Contact with {contact.name} (not cuttable by this tool): {contact.depth_mm:.2f} mm deep. "
+                                     f"To drill it, make it cuttable here or set its role in the Segments panel.")
+            self.state.vc_contact_fix = {"id": contact.segment_id, "name": contact.name}
         self.drill.set_glyph(in_contact=True)
         self.state.flush()
 
@@ -415,7 +427,7 @@ class VolumeCuttingApp(TrameApp):
         # The slice views follow the tool when the stroke ends; meanwhile the 3D view has the processor.
         for view in self.slicer_app.view_manager.get_slice_views():
             view.set_render_blocked(True)
-        self.state.vc_contact = ""
+        self.state.vc_contact, self.state.vc_contact_fix = "", None
         self.drill.set_glyph(in_contact=False)
 
     def _on_stroke_moved(self) -> None:
@@ -446,7 +458,7 @@ class VolumeCuttingApp(TrameApp):
         if not self.session.has_data:
             return
         step()
-        self.state.vc_contact = ""
+        self.state.vc_contact, self.state.vc_contact_fix = "", None
         self.state.vc_sc_status = ""
         self.drill.set_glyph(in_contact=False)
         self._refresh_tables()

@@ -20,6 +20,7 @@ resliced CT, drawn pixel for pixel (on llvmpipe 8x multisampling made a
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 
@@ -115,6 +116,35 @@ def add_product_displayable_manager(view, manager):
     return manager
 
 
+def _box_center(bounds):
+    return [(bounds[2 * axis] + bounds[2 * axis + 1]) / 2.0 for axis in range(3)]
+
+
+def fitting_distance(bounds, direction, view_up, view_angle_deg: float, aspect: float, margin: float = 0.05) -> float:
+    """The camera distance from the box's centre along ``direction`` at which the whole box is in a perspective view.
+
+    ``view_angle_deg`` is the vertical view angle, ``aspect`` width / height. A corner at ``along`` towards
+    the eye and ``across`` off the axis is inside when across / (distance - along) <= tan(half angle).
+    """
+    forward = np.asarray(direction, dtype=float)
+    forward /= np.linalg.norm(forward)
+    up = np.asarray(view_up, dtype=float) - np.dot(view_up, forward) * forward
+    if np.linalg.norm(up) < 1e-9:  # looking along the up vector: any perpendicular will do
+        up = np.cross(forward, [1.0, 0.0, 0.0] if abs(forward[0]) < 0.9 else [0.0, 1.0, 0.0])
+    up /= np.linalg.norm(up)
+    right = np.cross(forward, up)
+    tan_vertical = math.tan(math.radians(view_angle_deg) / 2.0) * (1.0 - margin)
+    tan_horizontal = tan_vertical * aspect
+    center = np.array(_box_center(bounds))
+    distance = 0.0
+    for corner in itertools.product(*((bounds[2 * a], bounds[2 * a + 1]) for a in range(3))):
+        offset = np.array(corner) - center
+        along = float(np.dot(offset, forward))
+        distance = max(distance, along + abs(float(np.dot(offset, up))) / tan_vertical,
+                       along + abs(float(np.dot(offset, right))) / tan_horizontal)
+    return max(distance, 1e-3)
+
+
 class VolumeCutThreeDView(ThreeDView):
     """trame-slicer's 3D view with the product's volume-cut displayable manager."""
 
@@ -128,11 +158,17 @@ class VolumeCutThreeDView(ThreeDView):
             view_node.SetBoxVisible(False)
             view_node.SetAxisLabelsVisible(False)
 
-    def look_from(self, bounds, direction, distance_factor=2.2, view_up=(0.0, 0.0, 1.0)) -> None:
-        """Look at the centre of ``bounds`` (RAS) from ``direction`` (towards the eye)."""
-        center = [(bounds[2 * axis] + bounds[2 * axis + 1]) / 2.0 for axis in range(3)]
-        extent = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4])
-        self.look_at(center, direction, distance_factor * extent, view_up)
+    def look_from(self, bounds, direction, view_up=(0.0, 0.0, 1.0), margin=0.05) -> None:
+        """Look at the centre of ``bounds`` (RAS) from ``direction`` (towards the eye), the whole box in view.
+
+        The distance is the nearest at which every corner of the box projects inside the view, less
+        ``margin`` of its half-size on each side, at this view's aspect: a scan whose tissue fills its
+        box (a temporal-bone block) opens whole, not as a close-up of its near face.
+        """
+        width, height = self.render_window().GetSize() if self.render_window() is not None else (1, 1)
+        aspect = width / height if width > 0 and height > 0 else 1.0
+        self.look_at(_box_center(bounds), direction, fitting_distance(bounds, direction, view_up, 30.0, aspect, margin),
+                     view_up)
 
     def look_at(self, center, direction, distance, view_up=(0.0, 0.0, 1.0)) -> None:
         """Look at ``center`` (RAS) from ``distance`` mm along ``direction`` (towards the eye)."""
