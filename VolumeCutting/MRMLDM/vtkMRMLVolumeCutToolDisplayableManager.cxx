@@ -177,12 +177,17 @@ void vtkMRMLVolumeCutToolDisplayableManager::OnMRMLSceneNodeAdded(vtkMRMLNode* n
   {
     return;
   }
-  vtkNew<vtkIntArray> events;
-  events->InsertNextValue(vtkCommand::ModifiedEvent);
-  events->InsertNextValue(vtkMRMLVolumeCutToolNode::ToolGeometryModifiedEvent);
-  events->InsertNextValue(vtkMRMLTransformableNode::TransformModifiedEvent);
-  events->InsertNextValue(vtkMRMLDisplayableNode::DisplayModifiedEvent);
-  vtkObserveMRMLNodeEventsMacro(toolNode, events);
+  // UpdateFromMRMLScene (after every batch, import or view change) passes known tools again: observing
+  // them twice made the observer manager warn once per tool and event.
+  if (!this->Impl->Pipelines.count(toolNode))
+  {
+    vtkNew<vtkIntArray> events;
+    events->InsertNextValue(vtkCommand::ModifiedEvent);
+    events->InsertNextValue(vtkMRMLVolumeCutToolNode::ToolGeometryModifiedEvent);
+    events->InsertNextValue(vtkMRMLTransformableNode::TransformModifiedEvent);
+    events->InsertNextValue(vtkMRMLDisplayableNode::DisplayModifiedEvent);
+    vtkObserveMRMLNodeEventsMacro(toolNode, events);
+  }
   this->UpdatePipeline(toolNode);
   this->RequestRender();
 }

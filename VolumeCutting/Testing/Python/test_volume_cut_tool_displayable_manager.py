@@ -66,3 +66,30 @@ def test_tool_glyph_follows_the_tool():
     application.scene.RemoveNode(tool)
     assert manager.GetToolActor(tool) is None
     view.close()
+
+
+def test_a_scene_update_observes_each_tool_once_without_warnings():
+    """After a batch (a scene import, a bundle read) the manager sees every tool again; it warned 'Observation
+    already exists' once per tool and event each time (32 lines in a main job run)."""
+    import slicer
+
+    application = HeadlessSlicer()
+    presets = {preset.name: preset for preset in toolconfig.load_presets()}
+    tools = [toolconfig.create_tool_node(application.scene, toolconfig.from_preset(presets[name]), name)
+             for name in ("Cutting burr 5 mm", "Diamond burr 3 mm")]
+    view = application.create_3d_view(64, 64)
+    messages = vtk.vtkStringOutputWindow()
+    previous = vtk.vtkOutputWindow.GetInstance()
+    vtk.vtkOutputWindow.SetInstance(messages)
+    try:
+        for _ in range(2):
+            application.scene.StartState(slicer.vtkMRMLScene.BatchProcessState)
+            application.scene.EndState(slicer.vtkMRMLScene.BatchProcessState)
+    finally:
+        vtk.vtkOutputWindow.SetInstance(previous)
+    assert "already exist" not in messages.GetOutput(), messages.GetOutput()
+    # Still observed once: a change of size reaches the glyph.
+    tools[0].SetDiameter(4.0)
+    bounds = view.tool_displayable_manager.GetToolActor(tools[0]).GetBounds()
+    assert bounds[1] - bounds[0] == pytest.approx(4.0, rel=0.01)
+    view.close()
