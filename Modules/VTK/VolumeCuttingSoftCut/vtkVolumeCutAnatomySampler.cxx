@@ -33,22 +33,6 @@ void CopyBox(const T* data, const int dims[3], const int box[6], float* out)
 } // namespace
 
 //------------------------------------------------------------------------------
-double vtkVolumeCutAnatomySampler::Voxel(int i, int j, int k) const
-{
-  i = std::max(0, std::min(this->Dims[0] - 1, i));
-  j = std::max(0, std::min(this->Dims[1] - 1, j));
-  k = std::max(0, std::min(this->Dims[2] - 1, k));
-  if (i >= this->LocalBox[0] && i <= this->LocalBox[1] && j >= this->LocalBox[2] && j <= this->LocalBox[3] && k >= this->LocalBox[4] &&
-    k <= this->LocalBox[5])
-  {
-    const int sx = this->LocalBox[1] - this->LocalBox[0] + 1;
-    const int sy = this->LocalBox[3] - this->LocalBox[2] + 1;
-    return this->Local[(static_cast<size_t>(k - this->LocalBox[4]) * sy + (j - this->LocalBox[2])) * sx + (i - this->LocalBox[0])];
-  }
-  return this->Scalars->GetComponent((static_cast<vtkIdType>(k) * this->Dims[1] + j) * this->Dims[0] + i, 0);
-}
-
-//------------------------------------------------------------------------------
 void vtkVolumeCutAnatomySampler::ForgetCache()
 {
   this->LocalBox[0] = this->LocalBox[2] = this->LocalBox[4] = 0;
@@ -107,30 +91,6 @@ bool vtkVolumeCutAnatomySampler::CopyVoxels(int box[6], std::vector<float>& out)
     }
   }
   return true;
-}
-
-//------------------------------------------------------------------------------
-double vtkVolumeCutAnatomySampler::Sample(const Vec& x) const
-{
-  double index[3];
-  int base[3];
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    index[axis] = x[axis] / this->Spacing[axis];
-    base[axis] = static_cast<int>(std::floor(index[axis]));
-    index[axis] -= base[axis];
-  }
-  double value = 0.0;
-  for (int corner = 0; corner < 8; ++corner)
-  {
-    const int d[3] = { corner & 1, (corner >> 1) & 1, (corner >> 2) & 1 };
-    const double w = (d[0] ? index[0] : 1.0 - index[0]) * (d[1] ? index[1] : 1.0 - index[1]) * (d[2] ? index[2] : 1.0 - index[2]);
-    if (w != 0.0)
-    {
-      value += w * this->Voxel(base[0] + d[0], base[1] + d[1], base[2] + d[2]);
-    }
-  }
-  return value;
 }
 
 //------------------------------------------------------------------------------

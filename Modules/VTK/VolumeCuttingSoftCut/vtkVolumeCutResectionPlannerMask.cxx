@@ -13,8 +13,9 @@ using namespace vtkVolumeCutSoftCut;
 
 namespace
 {
-/// Trilinear value of the plan's box copy at a grid-frame point (clamped to the box).
-double BoxSample(const PlanData& plan, const double spacing[3], const Vec& x)
+/// Trilinear value of the plan's box copy at a grid-frame point (clamped to
+/// the box); inline, as it was, for the skin search run per skin voxel.
+inline double BoxSample(const PlanData& plan, const double spacing[3], const Vec& x)
 {
   double f[3];
   int base[3];
