@@ -1,7 +1,7 @@
 """Drilling with the input device chosen in the tool panel: what its "Drill" button runs.
 
 The panel lists the mouse and the known devices plugged in
-(:func:`VolumeCuttingLib.inputdevices.list_devices`); :class:`HapticDrilling`
+(:func:`VolumeCuttingLib.config.inputdevices.list_devices`); :class:`HapticDrilling`
 turns the chosen one into a haptic device, starts the logic's haptic session
 (``vtkSlicerVolumeCuttingHapticSession``: the loop on its own thread, the
 force model on what the view draws) on the cut node's active tool, and, for

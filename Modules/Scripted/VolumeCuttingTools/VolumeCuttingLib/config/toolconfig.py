@@ -27,7 +27,7 @@ from pathlib import Path
 import slicer
 
 from .inputdevices import InputDevice, list_devices  # noqa: F401  (part of this module's interface)
-from .resources import find_resource
+from ..scene.resources import find_resource
 
 PRESETS_FILE_NAME = "VolumeCuttingToolPresets.json"
 PRESETS_FORMAT = "VolumeCuttingToolPresets"

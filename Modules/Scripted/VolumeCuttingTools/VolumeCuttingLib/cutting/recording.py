@@ -8,7 +8,7 @@ Replaying it moves each tool node through ``vtkSlicerVolumeCuttingLogic.
 MoveActiveTool`` inside ``BeginStroke`` / ``EndStroke``, exactly as a live
 session does, so tests, demos and session review all run the product's path.
 
-    python -m VolumeCuttingLib.recording --head-ct OUT.json   # record the shipped mastoidectomy
+    python -m VolumeCuttingLib.cutting.recording --head-ct OUT.json   # record the shipped mastoidectomy
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .resources import find_resource
+from ..scene.resources import find_resource
 
 FORMAT = "VolumeCuttingRecording"
 VERSION = 1
@@ -169,13 +169,13 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--head-ct", type=Path, required=True, help="write the shipped head-CT mastoidectomy recording here")
     args = parser.parse_args(argv)
-    from . import drilling, headct
-    from .application import HeadlessSlicer
-    from .mainjob import HEAD_CT_RIGHT_MASTOID_YZ
+    from . import drilling
+    from ..data import headct
+    from ..scene.application import HeadlessSlicer
 
     application = HeadlessSlicer()
     volume = headct.load_volume_node(application.scene, name="HeadCT")
-    plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *HEAD_CT_RIGHT_MASTOID_YZ))
+    plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *headct.RIGHT_MASTOID_YZ))
     recording = record_mastoidectomy(
         plan, description="Cortical mastoidectomy of the right mastoid of Debian's invesalius-examples head CT: "
         "saucerised layers with a 5 mm cutting burr ('cutting'), the last two polished with a 3 mm diamond burr ('diamond').")

@@ -16,7 +16,7 @@ import numpy as np
 import slicer
 import vtk
 
-from . import nodes
+from ..scene import nodes
 
 
 def create_logic(application):

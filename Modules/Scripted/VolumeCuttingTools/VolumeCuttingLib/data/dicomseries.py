@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import nodes
+from ..scene import nodes
 
 CT_IMAGE_STORAGE = "1.2.840.10008.5.1.4.1.1.2"
 RAS_TO_LPS = np.diag([-1.0, -1.0, 1.0])

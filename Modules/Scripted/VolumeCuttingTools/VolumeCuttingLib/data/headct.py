@@ -67,6 +67,12 @@ IJK_TO_RAS_DIRECTIONS = np.array([[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 
 # corrupt int16 data lands there almost surely.
 PLAUSIBLE_HU_RANGE = (-2048, 4095)
 
+# Centre (y, z in RAS mm) of the right mastoid, read off the pinned data:
+# slice k=21, row j=108, where the air cells lie behind the ear canal (the
+# lateral cortex there is at i=67). The main job and the shipped recording
+# drill there.
+RIGHT_MASTOID_YZ = (-18.6, -48.75)
+
 _DOWNLOAD_TIMEOUT_S = 900
 _STAMP_NAME = ".verified-sha256"
 
@@ -301,7 +307,7 @@ def load_array(path=None, cache_dir=None):
 
 def load_volume_node(scene, name="HeadCT", path=None, cache_dir=None):
     """Add the head CT to ``scene`` as a ``vtkMRMLScalarVolumeNode`` (int16 HU) and return it."""
-    from . import nodes
+    from ..scene import nodes
 
     array, _, ijk_to_ras = load_array(path, cache_dir)
     return nodes.create_scalar_volume_node(scene, array, ijk_to_ras, name)

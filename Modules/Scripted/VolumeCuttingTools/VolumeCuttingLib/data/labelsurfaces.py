@@ -22,8 +22,9 @@ import slicer
 import vtk
 from vtkmodules.util import numpy_support
 
-from . import analyticscene, nodes
-from .application import HeadlessSlicer
+from . import analyticscene
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer
 
 SPACING = (0.7, 0.7, 2.5)
 DIMENSIONS = (72, 72, 22)  # x, y, z voxels: 50 x 50 x 52 mm

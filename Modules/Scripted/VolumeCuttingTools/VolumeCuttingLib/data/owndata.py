@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import nodes
+from ..scene import nodes
 
 VOLUME_EXTENSIONS = (".nrrd", ".nhdr", ".nii", ".nii.gz", ".mha", ".mhd")
 SEGMENTATION_EXTENSION = ".seg.nrrd"

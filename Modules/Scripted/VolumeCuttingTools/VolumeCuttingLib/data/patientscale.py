@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import nodes
+from ..scene import nodes
 
 DIMENSIONS = (512, 512, 133)
 SPACING = (0.70, 0.70, 2.5)

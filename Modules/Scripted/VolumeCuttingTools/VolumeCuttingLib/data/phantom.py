@@ -1084,7 +1084,7 @@ def _rasterize(anatomy, dimensions, spacing, origin, direction, supersampling):
 
 def create_volume_node(scene, phantom, name="TemporalBonePhantom"):
     """Add a ``vtkMRMLScalarVolumeNode`` with the phantom CT (exact IJK-to-RAS) to ``scene``."""
-    from . import nodes
+    from ..scene import nodes
 
     return nodes.create_scalar_volume_node(scene, phantom.ct, phantom.ijk_to_ras, name)
 
@@ -1101,7 +1101,7 @@ def create_segmentation_node(scene, phantom, volume_node, name="TemporalBonePhan
     import slicer
     from vtkmodules.util import numpy_support
 
-    from . import nodes
+    from ..scene import nodes
 
     segmentation_node = scene.AddNewNodeByClass("vtkMRMLSegmentationNode", name)
     segmentation_node.SetReferenceImageGeometryParameterFromVolumeNode(volume_node)

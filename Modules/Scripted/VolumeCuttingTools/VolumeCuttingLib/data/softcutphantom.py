@@ -169,6 +169,6 @@ def exact_volume_average_normal(skin_radius: float, radius: float, depth: float,
 
 def add_volume_node(scene, phantom: SpherePhantom, name="SpherePhantom"):
     """The phantom's CT as a scalar volume node (float HU)."""
-    from . import nodes
+    from ..scene import nodes
 
     return nodes.create_scalar_volume_node(scene, phantom.ct, phantom.ijk_to_ras, name)

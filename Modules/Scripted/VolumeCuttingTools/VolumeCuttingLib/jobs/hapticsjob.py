@@ -21,7 +21,8 @@ import numpy as np
 import slicer
 import vtk
 
-from . import recording, toolconfig
+from ..config import toolconfig
+from ..cutting import recording
 
 #: The tool the session drills with.
 BURR_PRESET = "Cutting burr 4 mm"

@@ -1,8 +1,8 @@
 """The main job: a segmentation-then-drill session without the Slicer GUI.
 
-    python -m VolumeCuttingLib.mainjob [--phantom] [--out DIR]
-    python -m VolumeCuttingLib.mainjob --ct PATH [--segmentation PATH] [--color-table PATH]
-                                       [--cuttable NAMES] [--protected NAMES] [--out DIR]
+    python -m VolumeCuttingLib.jobs.mainjob [--phantom] [--out DIR]
+    python -m VolumeCuttingLib.jobs.mainjob --ct PATH [--segmentation PATH] [--color-table PATH]
+                                            [--cuttable NAMES] [--protected NAMES] [--out DIR]
 
 On the real head CT (Debian's invesalius-examples, fetched at setup), on the
 procedural temporal-bone phantom, or on the user's own CT (a DICOM series,
@@ -29,8 +29,11 @@ from pathlib import Path
 import numpy as np
 import slicer
 
-from . import drilling, hapticsjob, headct, owndata, phantom, recording, selftests, softcutjob, toolconfig
-from .application import HeadlessSlicer
+from . import hapticsjob, selftests, softcutjob
+from ..config import toolconfig
+from ..cutting import drilling, recording
+from ..data import headct, owndata, phantom
+from ..scene.application import HeadlessSlicer
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
 # the structures whose injury is the complication the trainee must avoid.
@@ -39,11 +42,6 @@ PHANTOM_CUTTABLE_SEGMENTS = ("SoftTissue", "MastoidCortex", "MastoidBone", "Mast
 PHANTOM_BONE_SEGMENTS = ("MastoidCortex", "MastoidBone", "FacialCanalWall")
 PHANTOM_PROTECTED_SEGMENTS = (
     "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
-
-# Centre (y, z in RAS mm) of the right mastoid on the real head CT, read off
-# the pinned data: slice k=21, row j=108, where the air cells lie behind the
-# ear canal (the lateral cortex there is at i=67).
-HEAD_CT_RIGHT_MASTOID_YZ = (-18.6, -48.75)
 
 # On the user's own CT: a short path into the cuttable bone with a 3.5 mm burr.
 OWN_DATA_PLAN = {"surface_radius": 4.0, "depth": 4.0, "burr_radius": 1.75}
@@ -191,7 +189,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         entry = drilling.lateral_entry_into_segments(roles_segmentation, list(cut_node.GetCuttableSegmentIDs()))
         plan = drilling.MastoidectomyPlan(entry=entry, **OWN_DATA_PLAN)
     else:
-        plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *HEAD_CT_RIGHT_MASTOID_YZ))
+        plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *headct.RIGHT_MASTOID_YZ))
     # The cut anatomy as the product shows it: through the adaptive multivolume
     # ray-cast mapper (vtkMRMLVolumeCutDisplayableManager), before and after.
     # The segmentation's own surfaces stay hidden; its segments colour the view.

@@ -76,7 +76,7 @@ def _tube_segment(segmentation_node, volume_node, name, start, end, radius):
     """Add a segment of the voxels within ``radius`` of the segment start-end (RAS), on the CT's grid."""
     import slicer
 
-    from . import nodes
+    from ..scene import nodes
 
     image = volume_node.GetImageData()
     dims = image.GetDimensions()
@@ -113,8 +113,10 @@ def dicom_mastoidectomy_with_presets_and_reload(context: SelfTestContext) -> dic
     volumes per segment with the protected one at zero, STL and segment exported, the bundle reloaded with the same cut."""
     import vtk
 
-    from . import dicomseries, headct, owndata, recording, toolconfig
-    from .application import HeadlessSlicer
+    from ..config import toolconfig
+    from ..cutting import recording
+    from ..data import dicomseries, headct, owndata
+    from ..scene.application import HeadlessSlicer
 
     scene, logic, folder = context.scene, context.logic, Path(context.folder)
 

@@ -29,8 +29,10 @@ import numpy as np
 import slicer
 import vtk
 
-from . import headct, nodes, softcut
-from .application import HeadlessSlicer, _write_screenshot
+from ..cutting import softcut
+from ..data import headct
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer, _write_screenshot
 
 # The outline: an ellipse of 34 x 24 mm centred on the right cheek (RAS, mm),
 # below the eye and lateral to the nose, seen from the patient's right front.

@@ -11,7 +11,7 @@ def find_resource(*relative: str) -> Path:
     in the source tree (top-level Resources). Raises FileNotFoundError naming
     the places tried.
     """
-    library = Path(__file__).resolve().parent
+    library = Path(__file__).resolve().parents[1]
     roots = [library / "Resources", library.parent / "Resources"]
     if len(library.parents) > 3:
         roots.append(library.parents[3] / "Resources")
