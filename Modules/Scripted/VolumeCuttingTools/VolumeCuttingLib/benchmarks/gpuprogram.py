@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .benchmarks import machine_description, measurement
+from .harness import machine_description, measurement
 
 WIDTH = 128
 
@@ -59,7 +59,7 @@ def one_start(cache_directory: str, use_cache: bool, features: dict) -> dict:
     import slicer_volumecutting as vc
     import vtk
 
-    from . import analyticscene as A
+    from ..data import analyticscene as A
 
     scene = A.default_scene()
     window = vtk.vtkRenderWindow()
@@ -126,12 +126,12 @@ def one_start(cache_directory: str, use_cache: bool, features: dict) -> dict:
 def _start(mesa_cache: Path, our_cache: Path, use_cache: bool, features: dict) -> dict:
     """One start in a new process with these cache folders."""
     code = (
-        "import json, sys; from VolumeCuttingLib import programbenchmarks as p; "
+        "import json, sys; from VolumeCuttingLib.benchmarks import gpuprogram as p; "
         f"print('RESULT ' + json.dumps(p.one_start({str(our_cache)!r}, {use_cache!r}, {features!r})))"
     )
     environment = dict(os.environ, MESA_SHADER_CACHE_DIR=str(mesa_cache))
     environment.pop("MESA_SHADER_CACHE_DISABLE", None)
-    environment["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[1]), environment.get("PYTHONPATH", "")])
+    environment["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[2]), environment.get("PYTHONPATH", "")])
     result = subprocess.run([sys.executable, "-c", code], env=environment, capture_output=True, text=True, timeout=900)
     lines = [line for line in result.stdout.splitlines() if line.startswith("RESULT ")]
     if result.returncode != 0 or not lines:
@@ -162,7 +162,7 @@ def _alternating_case(ct, labels, ijk_to_ras, repeats: int, switch: str, width: 
     import vtk
     from vtkmodules.util import numpy_support
 
-    from .mapperbenchmarks import _finish
+    from .harness import finish_frame
 
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
@@ -200,7 +200,7 @@ def _alternating_case(ct, labels, ijk_to_ras, repeats: int, switch: str, width: 
         window.Modified()
         start, cpu = time.perf_counter(), time.process_time()
         window.Render()
-        _finish(window)
+        finish_frame(window)
         if mapper.GetLastRenderPath() != vc.vtkVolumeCutVolumeMapper.GPUPath:
             raise RuntimeError(f"gpuprogram benchmark: the GPU path did not draw: {mapper.GetGPUFallbackReason()}")
         return time.perf_counter() - start, time.process_time() - cpu
@@ -259,7 +259,7 @@ def _alternating_case(ct, labels, ijk_to_ras, repeats: int, switch: str, width: 
 
 
 def _cases():
-    from . import headct, patientscale
+    from ..data import headct, patientscale
 
     head, _, head_ijk_to_ras = headct.load_array()
     patient = patientscale.generate(head=(head, head_ijk_to_ras))
@@ -294,7 +294,7 @@ def texture_formats(repeats: int, cases: dict) -> list[dict]:
 
 def texture_filtering(repeats: int) -> list[dict]:
     """GPU-path frame time on the head CT, its R16 CT interpolated by the texture unit against the shader's texel fetches."""
-    from . import headct
+    from ..data import headct
 
     head, _, head_ijk_to_ras = headct.load_array()
     load_before = os.getloadavg()

@@ -36,9 +36,10 @@ import numpy as np
 import slicer
 import vtk
 
-from . import hapticsjob, nodes
-from .application import HeadlessSlicer, opengl_renderer_name
-from .benchmarks import _grid, machine_description, measurement
+from ..jobs import hapticsjob
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer, opengl_renderer_name
+from .harness import grid_matrix, machine_description, measurement
 
 STROKE_POSES = 500
 CT_DIMENSIONS = (200, 200, 160)
@@ -70,7 +71,7 @@ def _strokes(machine) -> list[dict]:
 
     def sphere_times():
         field = slicer.vtkVolumeCutField()
-        field.Initialize(dims, _grid(0.33, dims), 2)
+        field.Initialize(dims, grid_matrix(0.33, dims), 2)
         times, cpu = [], []
         field.BeginStroke()
         for p0, p1 in zip(poses[:-1], poses[1:]):
@@ -83,7 +84,7 @@ def _strokes(machine) -> list[dict]:
 
     def tool_times(tool):
         field = slicer.vtkVolumeCutField()
-        field.Initialize(dims, _grid(0.33, dims), 2)
+        field.Initialize(dims, grid_matrix(0.33, dims), 2)
         times, cpu = [], []
         field.BeginStroke()
         for m0, m1 in zip(matrices[:-1], matrices[1:]):

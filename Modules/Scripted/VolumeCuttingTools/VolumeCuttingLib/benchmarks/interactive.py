@@ -31,9 +31,11 @@ import time
 
 import vtk
 
-from . import drilling, headct, mainjob, patientscale
-from .application import HeadlessSlicer, opengl_renderer_name
-from .benchmarks import machine_description, measurement
+from ..cutting import drilling
+from ..data import headct, patientscale
+from ..jobs import mainjob
+from ..scene.application import HeadlessSlicer, opengl_renderer_name
+from .harness import machine_description, measurement
 
 SIZE = (1024, 768)
 INTERACTIVE_RATE = 20.0  # frames per second while interacting: 50 ms a frame
@@ -80,7 +82,7 @@ def _head_ct_view():
     cut_node.SetSurfaceIsoValue(300.0)
     cut_node.SetThinBoneShading(True)
     cut_node.SetThinBoneThickness(1.0)
-    plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *mainjob.HEAD_CT_RIGHT_MASTOID_YZ))
+    plan = drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *headct.RIGHT_MASTOID_YZ))
     drilling.drill(logic, cut_node, plan)
     view = application.create_3d_view(*SIZE)
     mainjob.cavity_camera(view, plan)

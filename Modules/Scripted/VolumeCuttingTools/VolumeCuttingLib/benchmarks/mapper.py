@@ -1,6 +1,6 @@
 """Benchmark area ``mapper``: the adaptive multivolume ray-cast mapper.
 
-Accuracy on the analytic cut cube (VolumeCuttingLib.analyticscene) at 512^2,
+Accuracy on the analytic cut cube (VolumeCuttingLib.data.analyticscene) at 512^2,
 8 pixels per voxel, for the CPU reference, the OpenGL path and, in the same
 run, VTK's stock vtkGPUVolumeRayCastMapper on the CT masked by the cut (voxels
 removed by at least half set to air: what Slicer offers today). Frame times
@@ -21,9 +21,9 @@ import slicer_volumecutting as vc
 import vtk
 from vtkmodules.util import numpy_support
 
-from . import analyticscene as A
-from .application import opengl_renderer_name
-from .benchmarks import machine_description, measurement, timed
+from ..data import analyticscene as A
+from ..scene.application import opengl_renderer_name
+from .harness import finish_frame, machine_description, measurement, timed
 
 
 def _stock_volume(scene, masked):
@@ -74,20 +74,15 @@ def _window(width):
     return window, renderer
 
 
-def _finish(window):
-    # Reading a pixel waits for the GPU to finish the frame.
-    window.GetRGBACharPixelData(0, 0, 0, 0, 1, vtk.vtkUnsignedCharArray())
-
-
 def _frame_time(window, repeats):
     """Median time of a whole frame, uploads and shader compilation left out."""
     window.Render()
-    _finish(window)
+    finish_frame(window)
 
     def frame():
         window.Modified()
         window.Render()
-        _finish(window)
+        finish_frame(window)
 
     return timed(frame, repeats)[0]
 
@@ -108,7 +103,7 @@ def _accuracy(scene, matrix, width, depth, own_normals=None):
 
 
 def _entry(name, value, unit, baseline_name, baseline_value, machine, repeats=1, details=None):
-    """A benchmark measurement (benchmarks.measurement), with optional details."""
+    """A benchmark measurement (harness.measurement), with optional details."""
     entry = measurement(name, float(value), unit, baseline_name, float(baseline_value), repeats, machine)
     if details is not None:
         entry["details"] = details
@@ -222,12 +217,12 @@ def mapper(repeats: int) -> list[dict]:
                     renderer.ResetCameraClippingRange()
                 ours_times = []
                 window.Render()
-                _finish(window)
+                finish_frame(window)
                 for _ in range(repeats if path == vc.vtkVolumeCutVolumeMapper.CPUPath else 1):
                     full_frames()
                     start = time.perf_counter()
                     window.Render()
-                    _finish(window)
+                    finish_frame(window)
                     ours_times.append(time.perf_counter() - start)
                 used = ours.GetMapper().GetLastRenderPathAsString()
                 renderer.RemoveVolume(ours)
@@ -254,7 +249,7 @@ def _localized_update(scene, intensities, cut, renderer, window, machine, repeat
     renderer.AddVolume(ours)
     mapper = ours.GetMapper()
     window.Render()
-    _finish(window)
+    finish_frame(window)
     size = window.GetSize()[0]
     matrix = A.world_to_ndc(renderer.GetActiveCamera(), size, size)
     caster = vc.vtkVolumeCutRayCaster()
@@ -280,7 +275,7 @@ def _localized_update(scene, intensities, cut, renderer, window, machine, repeat
         rays.append(caster.GetNumberOfRaysCast())
         start = time.perf_counter()
         window.Render()
-        _finish(window)
+        finish_frame(window)
         frames.append(time.perf_counter() - start)
         mapper_times.append(mapper.GetLastFrameTime())
     renderer.RemoveVolume(ours)
@@ -313,7 +308,7 @@ def _gpu_localized_update(scene, intensities, cut, renderer, window, machine, pa
     # are what is measured here.
     mapper.SetProgramBuildTimeLimit(600.0)
     window.Render()  # the program's build and first image
-    _finish(window)
+    finish_frame(window)
     size = window.GetSize()[0]
     renderer_name = opengl_renderer_name(window)
     localized, full, fractions = [], [], []
@@ -325,7 +320,7 @@ def _gpu_localized_update(scene, intensities, cut, renderer, window, machine, pa
         gpu.SetLocalizedUpdates(stroke % 2 == 0)
         start = time.perf_counter()
         window.Render()
-        _finish(window)
+        finish_frame(window)
         elapsed = time.perf_counter() - start
         if mapper.GetLastRenderPath() != vc.vtkVolumeCutVolumeMapper.GPUPath:
             raise RuntimeError(f"the OpenGL path did not draw: {mapper.GetGPUFallbackReason()}")

@@ -17,14 +17,13 @@ wheel), so the overlay's sampling runs on one core here.
 
 from __future__ import annotations
 
-import statistics
 import time
 
 import numpy as np
 
-from . import nodes
-from .application import HeadlessSlicer, opengl_renderer_name
-from .benchmarks import machine_description, measurement
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer, opengl_renderer_name
+from .harness import machine_description, measurement, millisecond_summary
 
 DIMENSIONS = (512, 512, 133)
 SPACING = (0.7, 0.7, 2.5)
@@ -59,16 +58,6 @@ def _stroke_path():
     return poses
 
 
-def _summary(times_s):
-    milliseconds = np.array(times_s) * 1e3
-    return {
-        "first": milliseconds[0],
-        "median": statistics.median(milliseconds),
-        "p99": float(np.percentile(milliseconds, 99)),
-        "max": milliseconds.max(),
-    }
-
-
 def sliceview(repeats: int) -> list[dict]:
     del repeats  # every stroke is one repeat
     application, cut_node, view = _chest_sized_scene()
@@ -98,10 +87,10 @@ def sliceview(repeats: int) -> list[dict]:
             frame_still.append(time.perf_counter() - wall)
     view.close()
 
-    still = _summary(frame_still)
+    still = millisecond_summary(frame_still)
     results = []
     for label, times in (("wall", update_wall), ("processor", update_cpu)):
-        summary = _summary(times)
+        summary = millisecond_summary(times)
         for statistic in ("first", "median", "p99", "max"):
             results.append(measurement(
                 f"slice view cut overlay update after one 5 mm burr stroke ({label} time, {statistic} of {len(times)}), "
@@ -109,7 +98,7 @@ def sliceview(repeats: int) -> list[dict]:
                 f"{min(samples)}-{max(samples)}, field {cut_node.GetCutField().GetNumberOfAllocatedBricks()} bricks at the end",
                 summary[statistic], "ms",
                 f"slice view frame with nothing changed (wall, {statistic})", still[statistic], len(times), machine))
-    after = _summary(frame_after)
+    after = millisecond_summary(frame_after)
     for statistic in ("first", "median", "p99", "max"):
         results.append(measurement(
             f"slice view frame after one burr stroke (wall, {statistic} of {len(frame_after)}), CT background and cut overlay",

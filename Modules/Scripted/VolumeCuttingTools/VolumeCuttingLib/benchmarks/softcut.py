@@ -38,10 +38,11 @@ import numpy as np
 import vtk
 from vtkmodules.util import numpy_support
 
-from . import headct, nodes, softcut
-from .application import HeadlessSlicer, opengl_renderer_name
-from .benchmarks import machine_description, measurement
-from .slicebenchmarks import _summary
+from ..cutting import softcut
+from ..data import headct
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer, opengl_renderer_name
+from .harness import machine_description, measurement, millisecond_summary
 
 # The paper's figures (ms): (shape, mask) per CT size.
 PUBLISHED_MS = {(256, 256, 230): (300.0, 400.0), (512, 512, 460): (4000.0, 3500.0)}
@@ -190,10 +191,10 @@ def _plan_case(dimensions, repeats):
         "area_mm2": planner.GetProjectedArea(),
         "plan_first_s": plan_first,
         "spacing": spacing,
-        "shape_cpu": _summary(shape_cpu),
-        "mask_cpu": _summary(mask_cpu),
+        "shape_cpu": millisecond_summary(shape_cpu),
+        "mask_cpu": millisecond_summary(mask_cpu),
     }
-    return (_summary(shape_times), _summary(mask_times), _summary(baseline_shape), _summary(baseline_mask), info,
+    return (millisecond_summary(shape_times), millisecond_summary(mask_times), millisecond_summary(baseline_shape), millisecond_summary(baseline_mask), info,
             (application, cut, logic))
 
 
@@ -222,7 +223,7 @@ def _preview_frames(session, repeats):
     mapper = view.volume_cut_displayable_manager.GetVolumeActor(cut).GetMapper()
     path = mapper.GetLastRenderPathAsString()
     view.close()
-    return _summary(updates), _summary(frames), _summary(still), renderer, path
+    return millisecond_summary(updates), millisecond_summary(frames), millisecond_summary(still), renderer, path
 
 
 def softcut_area(repeats: int) -> list[dict]:

@@ -40,8 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..benchmarks import machine_description, measurement
-from .browser import AppPage, AppServer, launch_chromium
+from ..webapp.browser import AppPage, AppServer, launch_chromium
+from .harness import machine_description, measurement
 
 VIEW_SIZE = (1024, 768)
 MOUSE_PERIOD_MS = 16.0

@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 import vtk
 
-from . import owndata, patientscale
-from .application import HeadlessSlicer
+from ..data import owndata, patientscale
+from ..scene.application import HeadlessSlicer
 
 BURR_RADIUS = 1.75  # a 3.5 mm burr, as in the report of issue 11
 
@@ -91,7 +91,7 @@ def _path_beside_the_cord(case, session, offset_mm=0.0, poses=20, step=0.5):
 
 
 def workflow(repeats: int) -> list[dict]:
-    from .benchmarks import machine_description, measurement
+    from .harness import machine_description, measurement
 
     _pin_to_one_core()
     machine = machine_description()
