@@ -69,7 +69,8 @@ def test_presets_are_found_from_the_installed_wheel(tmp_path):
     assert result.returncode == 0, result.stderr
     module_file, presets_file, count = result.stdout.split()
     assert "site-packages" in module_file
-    assert Path(presets_file).parent.parent.parent == Path(module_file).parent
+    # Resources/Presets/<file> inside the package root (toolconfig.py sits in its config/ subpackage).
+    assert Path(presets_file).parent.parent.parent == Path(module_file).parents[1]
     assert int(count) == len(PRESETS)
 
 
