@@ -39,7 +39,7 @@ def run_area(area: str, repeats: int) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog=f"python -m {__package__}", description=__doc__.splitlines()[0])
     parser.add_argument("--area", action="append", choices=sorted(AREAS), help="area to run (default: all)")
     parser.add_argument("--out", type=Path, default=Path("benchmarks") / "results")
     parser.add_argument("--repeat", type=int, default=3, help="runs per measurement; the median is reported")
