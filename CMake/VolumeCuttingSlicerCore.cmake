@@ -92,7 +92,7 @@ install(FILES Utilities/Python/slicer_volumecutting/__init__.py DESTINATION ${Vo
 install(FILES Utilities/Python/slicer/slicer_volumecutting.py DESTINATION slicer)
 install(DIRECTORY Modules/Scripted/VolumeCuttingTools/VolumeCuttingLib DESTINATION .
   PATTERN "__pycache__" EXCLUDE)
-# Data the library reads (VolumeCuttingLib.toolconfig finds it here, in
+# Data the library reads (VolumeCuttingLib.config.toolconfig finds it here, in
 # desktop Slicer's module resources and in the source tree).
 install(FILES Resources/Presets/VolumeCuttingToolPresets.json DESTINATION VolumeCuttingLib/Resources/Presets)
 install(FILES Resources/Sessions/HeadCTMastoidectomy.json DESTINATION VolumeCuttingLib/Resources/Sessions)

@@ -7,8 +7,8 @@ import pytest
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib import mainjob
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.jobs import mainjob
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 def read_png(path):
@@ -89,7 +89,7 @@ def test_main_job_on_the_real_head_ct(tmp_path):
 
 def test_protected_nerve_survives_a_stroke_through_it(tmp_path):
     """A pass aimed through the facial nerve leaves the nerve and reports the contact."""
-    from VolumeCuttingLib import phantom
+    from VolumeCuttingLib.data import phantom
 
     application = HeadlessSlicer()
     logic = application.volume_cutting_logic

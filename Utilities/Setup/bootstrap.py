@@ -145,7 +145,7 @@ def vtk_wheel_file(cache: Path) -> Path:
 
 def fetch_head_ct(cache: Path) -> Path | None:
     """Fetch the real head CT with the project's own loader, as a user's machine does."""
-    code = ("import sys; sys.path.insert(0, sys.argv[1]); from VolumeCuttingLib import headct; "
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); from VolumeCuttingLib.data import headct; "
             "print(headct.fetch(sys.argv[2]))")
     result = subprocess.run(
         [str(venv_python()), "-c", code, str(REPO / "Modules" / "Scripted" / "VolumeCuttingTools"), str(cache / "data")],

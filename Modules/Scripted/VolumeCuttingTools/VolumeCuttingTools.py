@@ -4,7 +4,7 @@ Thin by design: the widget only connects the GUI to VolumeCuttingToolsLogic, and
 the logic forwards to VolumeCuttingLib (Qt-free, tested with pytest against
 slicer-core) and to the C++ vtkSlicerVolumeCuttingLogic. Tool configuration
 (presets, shape, burr type, sizes, drive, per-segment sensibility, input
-device) is VolumeCuttingLib.toolconfig; this file only shows it.
+device) is VolumeCuttingLib.config.toolconfig; this file only shows it.
 """
 
 import logging
@@ -24,7 +24,9 @@ from slicer.ScriptedLoadableModule import (
 )
 from slicer.util import VTKObservationMixin
 
-from VolumeCuttingLib import hapticdrilling, headct, inputdevices, phantom, selftests, toolconfig
+from VolumeCuttingLib.config import hapticdrilling, inputdevices, toolconfig
+from VolumeCuttingLib.data import headct, phantom
+from VolumeCuttingLib.jobs import selftests
 
 # Read once: the parameter node's choices are fixed when the module loads.
 TOOL_PRESETS = {preset.name: preset for preset in toolconfig.load_presets()}
@@ -416,7 +418,7 @@ class VolumeCuttingToolsTest(ScriptedLoadableModuleTest):
         self.delayDisplay("Test passed")
 
     def runSelfTestCase(self, name):
-        """A case of VolumeCuttingLib.selftests, the same code pytest runs against slicer-core."""
+        """A case of VolumeCuttingLib.jobs.selftests, the same code pytest runs against slicer-core."""
         with tempfile.TemporaryDirectory(prefix=f"volumecutting-{name}-") as folder:
             context = selftests.SelfTestContext(slicer.mrmlScene, slicer.util.getModuleLogic("VolumeCutting"), Path(folder), self.delayDisplay)
             selftests.CASES[name](context)

@@ -1,4 +1,4 @@
-"""The tool panel's "Drill with this device": VolumeCuttingLib.hapticdrilling on a real scene and view.
+"""The tool panel's "Drill with this device": VolumeCuttingLib.config.hapticdrilling on a real scene and view.
 
 The mouse, chosen as the panel lists it, drills the block of
 test_haptic_session in a real offscreen 3D view through the real haptic loop;
@@ -13,9 +13,9 @@ import pytest
 
 from test_haptic_mouse_driver import CAMERA_X, SIZE, START, event, view
 from test_haptic_session import DISPLAY_PERIOD_S, add_burr, block_scene, place, tool_position
-from VolumeCuttingLib import inputdevices
-from VolumeCuttingLib.hapticdrilling import HapticDrilling, HapticDrillingError
-from VolumeCuttingLib.inputdevices import FOOT_SWITCH, HAPTIC, SIX_DOF, InputDevice
+from VolumeCuttingLib.config import inputdevices
+from VolumeCuttingLib.config.hapticdrilling import HapticDrilling, HapticDrillingError
+from VolumeCuttingLib.config.inputdevices import FOOT_SWITCH, HAPTIC, SIX_DOF, InputDevice
 
 
 def run_frames(drilling, seconds):

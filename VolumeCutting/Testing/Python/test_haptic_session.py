@@ -17,8 +17,10 @@ import slicer
 import vtk
 
 from test_session_persistence import VtkMessages
-from VolumeCuttingLib import hapticsjob, nodes, toolconfig
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.config import toolconfig
+from VolumeCuttingLib.jobs import hapticsjob
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 SHAPE = (30, 48, 48)  # k, j, i
 SPACING = (0.5, 0.5, 0.8)

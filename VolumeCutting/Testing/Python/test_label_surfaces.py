@@ -3,12 +3,12 @@
 An analytic ball and an oblique cylinder stored as binary labelmaps at
 0.7 x 0.7 x 2.5 mm, shown in one 3D view by the product and by Slicer's own
 closed-surface representation (default smoothing), from the same camera in
-the same run (VolumeCuttingLib.labelsurfaces): the depth error (RMS, mm) of
+the same run (VolumeCuttingLib.data.labelsurfaces): the depth error (RMS, mm) of
 the product's surface is no worse than Slicer's, and clearly better than
 the label map's own trilinear indicator.
 """
 
-from VolumeCuttingLib import labelsurfaces
+from VolumeCuttingLib.data import labelsurfaces
 
 
 def test_binary_segments_are_as_smooth_as_slicers_closed_surfaces():

@@ -12,8 +12,9 @@ import pytest
 import slicer
 import vtk
 
-from VolumeCuttingLib import nodes, toolconfig
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.config import toolconfig
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 SHAPE = (30, 48, 48)  # k, j, i
 SPACING = (0.5, 0.5, 0.8)

@@ -19,8 +19,9 @@ import pytest
 import slicer
 import vtk
 
-from VolumeCuttingLib import nodes, selftests
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.jobs import selftests
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 def rotation_about(axis, degrees):

@@ -2,7 +2,7 @@
 
 Real scene, real markups closed curve, real cut node and module logic, and a
 real 3D view for the preview. The anatomy is the sphere phantom of
-VolumeCuttingLib.softcutphantom (skin an analytic sphere over a bone shell),
+VolumeCuttingLib.data.softcutphantom (skin an analytic sphere over a bone shell),
 on an anisotropic grid whose i axis is flipped, so that volumes are checked
 against exact values.
 """
@@ -14,8 +14,10 @@ import pytest
 import slicer
 import vtk
 
-from VolumeCuttingLib import nodes, softcut, softcutphantom
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.cutting import softcut
+from VolumeCuttingLib.data import softcutphantom
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 RADIUS = 12.0  # mm from the axis: 12 voxels across in-plane
 MAXIMUM_DEPTH = 14.0

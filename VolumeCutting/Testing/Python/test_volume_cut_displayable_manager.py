@@ -2,7 +2,7 @@
 
 Real scene, real logic, Slicer's displayable-manager group and an offscreen
 render window; depths are checked against the exact geometry of the analytic
-cube (VolumeCuttingLib.analyticscene).
+cube (VolumeCuttingLib.data.analyticscene).
 """
 
 import math
@@ -13,8 +13,9 @@ import slicer
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib import analyticscene, nodes
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.data import analyticscene
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 @pytest.fixture()

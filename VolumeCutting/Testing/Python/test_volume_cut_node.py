@@ -10,7 +10,7 @@ import slicer
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 @pytest.fixture

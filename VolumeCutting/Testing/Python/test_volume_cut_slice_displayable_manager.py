@@ -15,8 +15,8 @@ import slicer
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib import nodes
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 SPACING = np.array([0.6, 0.7, 1.3])  # mm, anisotropic
 DIMENSIONS = (40, 36, 24)  # i, j, k

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import vtk
 
-from VolumeCuttingLib import toolconfig
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.config import toolconfig
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 def set_pose(tool, translation):

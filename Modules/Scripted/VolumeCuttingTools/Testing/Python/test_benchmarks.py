@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from VolumeCuttingLib.benchmarks import _union_of_capsules_volume, machine_description, measurement
+from VolumeCuttingLib.benchmarks.cutfield import _union_of_capsules_volume
+from VolumeCuttingLib.benchmarks.harness import machine_description, measurement
 
 
 def test_union_reference_on_known_volumes():

@@ -1,4 +1,4 @@
-"""Tests of the real head CT loader (VolumeCuttingLib.headct).
+"""Tests of the real head CT loader (VolumeCuttingLib.data.headct).
 
 Tests marked ``realdata`` use Debian's invesalius-examples package, fetched
 once into the user cache (outside the repository); they are skipped only if
@@ -13,7 +13,7 @@ import tarfile
 import numpy as np
 import pytest
 
-from VolumeCuttingLib import headct
+from VolumeCuttingLib.data import headct
 
 # --------------------------------------------------------------------------- synthetic .inv3 files
 
@@ -62,7 +62,7 @@ def test_synthetic_inv3_round_trip(tmp_path):
 
 def test_synthetic_volume_node(tmp_path):
     slicer = pytest.importorskip("slicer")
-    from VolumeCuttingLib import nodes
+    from VolumeCuttingLib.scene import nodes
 
     array = synthetic_array()
     path = write_inv3(tmp_path / "ok.inv3", default_plist(array), array.astype("<i2").tobytes())
@@ -240,7 +240,7 @@ def test_real_head_ct_fetch_is_cached(cranium_path, monkeypatch):
 @pytest.mark.realdata
 def test_real_head_ct_volume_node(cranium_path):
     slicer = pytest.importorskip("slicer")
-    from VolumeCuttingLib import nodes
+    from VolumeCuttingLib.scene import nodes
 
     scene = slicer.vtkMRMLScene()
     node = headct.load_volume_node(scene)

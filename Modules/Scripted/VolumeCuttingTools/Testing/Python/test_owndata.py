@@ -1,4 +1,4 @@
-"""Own data in (VolumeCuttingLib.owndata, dicomseries, patientscale): the user's CT and segmentation.
+"""Own data in (VolumeCuttingLib.data.owndata, dicomseries, patientscale): the user's CT and segmentation.
 
 Real scenes and Slicer's own storage nodes throughout. Small volumes are
 generated and written into ``tmp_path`` with Slicer's writers (and pydicom
@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 import slicer
 
-from VolumeCuttingLib import dicomseries, drilling, nodes, owndata, patientscale
+from VolumeCuttingLib.cutting import drilling
+from VolumeCuttingLib.data import dicomseries, owndata, patientscale
+from VolumeCuttingLib.scene import nodes
 
 MODULE_DIR = Path(__file__).resolve().parents[2]
 
@@ -517,7 +519,7 @@ def test_lateral_entry_into_segments(scene, tmp_path, named_segmentation, ct):
 
 def run_main_job(*arguments):
     environment = dict(os.environ, PYTHONPATH=str(MODULE_DIR))
-    return subprocess.run([sys.executable, "-m", "VolumeCuttingLib.mainjob", *map(str, arguments)],
+    return subprocess.run([sys.executable, "-m", "VolumeCuttingLib.jobs.mainjob", *map(str, arguments)],
                           capture_output=True, text=True, env=environment, timeout=300)
 
 
@@ -567,7 +569,7 @@ def test_main_job_bad_input_exits_1_with_one_message(tmp_path, arguments, named)
 
 @pytest.mark.realdata
 def test_patient_scale_case_loads_back_through_owndata(tmp_path):
-    from VolumeCuttingLib import headct
+    from VolumeCuttingLib.data import headct
 
     try:
         head = headct.load_array()

@@ -1,11 +1,11 @@
-"""Tests of the procedural temporal-bone phantom (VolumeCuttingLib.phantom)."""
+"""Tests of the procedural temporal-bone phantom (VolumeCuttingLib.data.phantom)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from VolumeCuttingLib import phantom as ph
+from VolumeCuttingLib.data import phantom as ph
 
 EXPECTED_EXACT = {
     "TegmenPlate",
@@ -404,7 +404,7 @@ def test_bad_input_raises_value_error(kwargs, message):
 
 def test_mrml_nodes_round_trip_oblique_anisotropic(oblique):
     slicer = pytest.importorskip("slicer")
-    from VolumeCuttingLib import nodes
+    from VolumeCuttingLib.scene import nodes
 
     scene = slicer.vtkMRMLScene()
     volume_node, segmentation_node = ph.create_phantom_nodes(scene, oblique, name="Phantom")

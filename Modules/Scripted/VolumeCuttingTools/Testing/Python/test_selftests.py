@@ -1,12 +1,12 @@
-"""The Slicer self-tests (VolumeCuttingLib.selftests) under pytest, against slicer-core.
+"""The Slicer self-tests (VolumeCuttingLib.jobs.selftests) under pytest, against slicer-core.
 
 Desktop Slicer runs the same cases as the VolumeCuttingTools module's self-test.
 """
 
 import pytest
 
-from VolumeCuttingLib import selftests
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.jobs import selftests
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 
 @pytest.mark.realdata

@@ -12,7 +12,8 @@ import pytest
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib import softcutbenchmarks, softcutjob
+from VolumeCuttingLib.benchmarks import softcut as softcutbenchmarks
+from VolumeCuttingLib.jobs import softcutjob
 
 
 def read_png(path):

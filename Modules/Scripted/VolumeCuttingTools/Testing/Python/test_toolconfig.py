@@ -1,4 +1,4 @@
-"""Tool configuration without Qt (VolumeCuttingLib.toolconfig and inputdevices).
+"""Tool configuration without Qt (VolumeCuttingLib.config.toolconfig and inputdevices).
 
 Real scenes, real tool and cut nodes; devices faced through umockdev where it
 is installed (Debian ``umockdev``), as /work/shared/notes/devices.md describes.
@@ -16,9 +16,9 @@ from pathlib import Path
 import pytest
 import slicer
 
-from VolumeCuttingLib import inputdevices, toolconfig
-from VolumeCuttingLib.application import HeadlessSlicer
-from VolumeCuttingLib.toolconfig import PresetError, ToolConfigError, ToolParameters
+from VolumeCuttingLib.config import inputdevices, toolconfig
+from VolumeCuttingLib.config.toolconfig import PresetError, ToolConfigError, ToolParameters
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 
 PRESETS = toolconfig.load_presets()
 LIBRARY_DIR = Path(toolconfig.__file__).resolve().parent
@@ -64,12 +64,13 @@ def test_the_presets_cover_otology_and_spine():
 
 def test_presets_are_found_from_the_installed_wheel(tmp_path):
     """In a fresh interpreter that sees only site-packages, the wheel's copy of the file is used."""
-    probe = "from VolumeCuttingLib import toolconfig as t; print(t.__file__); print(t.default_presets_path()); print(len(t.load_presets()))"
+    probe = "from VolumeCuttingLib.config import toolconfig as t; print(t.__file__); print(t.default_presets_path()); print(len(t.load_presets()))"
     result = subprocess.run([sys.executable, "-I", "-c", probe], cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     module_file, presets_file, count = result.stdout.split()
     assert "site-packages" in module_file
-    assert Path(presets_file).parent.parent.parent == Path(module_file).parent
+    # Resources/Presets/<file> inside the package root (toolconfig.py sits in its config/ subpackage).
+    assert Path(presets_file).parent.parent.parent == Path(module_file).parents[1]
     assert int(count) == len(PRESETS)
 
 
@@ -356,7 +357,7 @@ def test_known_devices_are_listed_under_umockdev(tmp_path):
         umockdev_device(tmp_path / "falcon.umockdev", raw_usb(3, 5, 0x0403, 0xCB48)),
         umockdev_device(tmp_path / "serial.umockdev", raw_usb(6, 7, 0x0403, 0x6001)),
     ]
-    probe = ("import json; from VolumeCuttingLib import inputdevices as d; "
+    probe = ("import json; from VolumeCuttingLib.config import inputdevices as d; "
              "print(json.dumps([[x.device_id, x.kind, x.backend, x.vendor_id, x.product_id, x.serial_number] for x in d.list_devices()]))")
     command = ["umockdev-run"] + [f"--device={f}" for f in files] + ["--", sys.executable, "-c", probe]
     result = subprocess.run(command, cwd=LIBRARY_DIR.parent, capture_output=True, text=True, timeout=120)

@@ -12,8 +12,8 @@ import pytest
 import slicer
 import vtk
 
-from VolumeCuttingLib import owndata
-from VolumeCuttingLib.application import HeadlessSlicer
+from VolumeCuttingLib.data import owndata
+from VolumeCuttingLib.scene.application import HeadlessSlicer
 from VolumeCuttingLib.webapp import app as webapp
 from VolumeCuttingLib.webapp import views
 from VolumeCuttingLib.webapp.session import DrillSession, SessionError, SoftCutSession, tool_pose
@@ -35,7 +35,7 @@ def session(tmp_path_factory):
 
 def lateral_point(session, y=0.0, z=0.0):
     """The first voxel of the mastoid cortex seen from the patient's right at (y, z) (RAS mm)."""
-    from VolumeCuttingLib import drilling
+    from VolumeCuttingLib.cutting import drilling
 
     return drilling.lateral_entry(session.volume, y, z, threshold=1000.0)
 
@@ -104,7 +104,7 @@ def test_tool_parameters_and_presets(session):
     assert session.tool_parameters() == params
     assert session.set_tool(diameter=3.0).diameter == 3.0
     assert session.tool_reach() == pytest.approx(1.5)
-    from VolumeCuttingLib import toolconfig
+    from VolumeCuttingLib.config import toolconfig
 
     with pytest.raises(toolconfig.ToolConfigError, match="diameter"):
         session.set_tool(diameter=70.0)
@@ -344,7 +344,7 @@ def test_softcut_bad_input_carves_nothing(head_session):
     removed = head_session.total_removed_volume()
     with pytest.raises(SessionError, match="no SoftCut outline yet"):
         softcut.carve(5.0)
-    points = __import__("VolumeCuttingLib.softcut", fromlist=["picked_points"]).picked_points(
+    points = __import__("VolumeCuttingLib.cutting.softcut", fromlist=["picked_points"]).picked_points(
         head_session.volume, (42.0, 62.0, -40.0), (-0.7, -0.7, -0.1), (10.0, 8.0), count=4)
     softcut.add_point(points[0])
     softcut.add_point(points[1])

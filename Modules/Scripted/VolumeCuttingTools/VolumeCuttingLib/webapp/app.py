@@ -42,7 +42,9 @@ from trame_slicer.views import Layout, LayoutDirection, ViewLayoutDefinition, Vi
 from trame_server.utils.asynchronous import create_task
 from wslink.websocket import LinkProtocol
 
-from .. import headct, owndata, softcutjob, toolconfig
+from ..config import toolconfig
+from ..data import headct, owndata
+from ..jobs import softcutjob
 from . import rendering, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)

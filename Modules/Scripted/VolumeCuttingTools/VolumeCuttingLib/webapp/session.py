@@ -35,8 +35,11 @@ import numpy as np
 import slicer
 import vtk
 
-from .. import headct, mainjob, owndata, phantom, softcut, softcutjob, toolconfig
-from ..application import configure_scene_io
+from ..config import toolconfig
+from ..cutting import softcut
+from ..data import headct, owndata, phantom
+from ..jobs import mainjob, softcutjob
+from ..scene.application import configure_scene_io
 
 ROLES = (toolconfig.ROLE_CUTTABLE, toolconfig.ROLE_PROTECTED, toolconfig.ROLE_NONE)
 

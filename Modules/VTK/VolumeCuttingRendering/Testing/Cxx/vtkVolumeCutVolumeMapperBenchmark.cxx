@@ -55,7 +55,7 @@ namespace
 {
 constexpr double Bone = 1000.0;
 
-/// The analytic cut cube of VolumeCuttingLib.analyticscene.default_scene:
+/// The analytic cut cube of VolumeCuttingLib.data.analyticscene.default_scene:
 /// faces through voxel centres, a two-voxel ramp, cuts across a corner, an
 /// edge, along an edge and into a face, all scaled with the grid.
 struct CutCube

@@ -26,7 +26,7 @@ def program_cache_in_a_temporary_folder(tmp_path_factory):
 @pytest.fixture(scope="module")
 def scene():
     """The analytic cut-cube scene (a module with other needs defines its own)."""
-    from VolumeCuttingLib import analyticscene
+    from VolumeCuttingLib.data import analyticscene
 
     return analyticscene.default_scene()
 

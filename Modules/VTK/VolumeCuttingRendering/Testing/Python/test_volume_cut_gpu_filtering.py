@@ -25,7 +25,7 @@ from test_volume_cut_gpu_textures import assert_images_agree, draw, image_of
 from test_volume_cut_mapper import add_cut_volume, look_down_z, render_window, set_transfer_functions, sphere_segment
 from vtk.util import numpy_support
 
-from VolumeCuttingLib import analyticscene as A
+from VolumeCuttingLib.data import analyticscene as A
 
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 CPU = vc.vtkVolumeCutVolumeMapper.CPUPath

@@ -11,7 +11,7 @@ import slicer_volumecutting as vc
 import vtk
 from test_volume_cut_mapper import add_cut_volume, read_window, render_window
 
-from VolumeCuttingLib import analyticscene as A
+from VolumeCuttingLib.data import analyticscene as A
 
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 WIDTH = 128

@@ -22,7 +22,7 @@ import slicer_volumecutting as vc
 import vtk
 from test_volume_cut_mapper import ErrorLog, add_cut_volume, read_window, render_window
 
-from VolumeCuttingLib import analyticscene as A
+from VolumeCuttingLib.data import analyticscene as A
 
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 CPU = vc.vtkVolumeCutVolumeMapper.CPUPath
@@ -203,7 +203,7 @@ def test_without_binary_formats_programs_are_built_from_source_without_warnings(
         f"""
         import slicer_volumecutting as vc
         from test_volume_cut_gpu_program import cut_cube, ErrorLog, GPU
-        from VolumeCuttingLib import analyticscene as A
+        from VolumeCuttingLib.data import analyticscene as A
         scene = A.default_scene(32)
         window, mapper = cut_cube(scene, scene.intensities(), {str(tmp_path)!r})
         mapper.SetRequestedRenderPath(GPU)

@@ -23,7 +23,7 @@ import vtk
 from test_volume_cut_mapper import read_window, render_window
 from vtk.util import numpy_support
 
-from VolumeCuttingLib import analyticscene as A
+from VolumeCuttingLib.data import analyticscene as A
 
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 CPU = vc.vtkVolumeCutVolumeMapper.CPUPath

@@ -14,7 +14,7 @@ import slicer_volumecutting as vc
 import vtk
 from vtkmodules.util import numpy_support
 
-from VolumeCuttingLib import analyticscene as A
+from VolumeCuttingLib.data import analyticscene as A
 
 
 class ErrorLog:

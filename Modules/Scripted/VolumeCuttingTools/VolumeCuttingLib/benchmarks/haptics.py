@@ -1,0 +1,252 @@
+"""Benchmark area ``haptics``: what one tick of the haptic loop costs, and how regular the loop is.
+
+Strokes: on the cut-field area's grid (512^3 voxels of 0.33 mm, factor 2),
+the first 500 poses of its helix (steps of 0.5 mm) swept by a 2.5 x 5 mm
+cylindrical burr and by a 20 mm disk saw 0.5 mm thick (a cylinder as long as
+its blade is thick, as the logic builds it), each against the 5 mm spherical
+burr's capsule strokes over the same poses in the same run, one core.
+
+Haptic update: a CT of 200 x 200 x 160 voxels of 0.4 mm holding a bone ball
+(1200 HU, 25 mm radius) in air, a cut node on it with a 4 mm cutting burr as
+its active tool, and the main job's recorded drilling session (hapticsjob:
+4.5 s, 2.5 s of it with the drill pushing into the bone) replayed through
+the haptic loop at 1 kHz. Once while the product's 3D view (the volume-cut
+ray caster, 600 x 600, llvmpipe) renders continuously on the main thread, and
+once, as the baseline, with the main thread only updating the scene at 60 Hz.
+A tick (device read, 82-point contact against the CT's iso-surface minus the
+cut field, force, proxy, cut stroke, recording) is timed by the loop itself;
+its period jitter too, and the processor time the haptic thread spent in
+each tick (its own CPU clock), which separates a tick's compute from the
+preemption a shared machine adds to its wall time. The first call is the first force-model step after
+Prepare at a pose in contact, timed from Python. The whole-voxel baseline is
+vtkHapticForceModel.CountWholeVoxelContacts (the nearest voxel's CT value and
+a whole-voxel cutter's removal for each shell point) at the replay's proxy
+positions, timed from Python per call, against ComputeContactForce (the same
+points against the sub-voxel fields) timed the same way.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import slicer
+import vtk
+
+from ..jobs import hapticsjob
+from ..scene import nodes
+from ..scene.application import HeadlessSlicer, opengl_renderer_name
+from .harness import grid_matrix, machine_description, measurement
+
+STROKE_POSES = 500
+CT_DIMENSIONS = (200, 200, 160)
+CT_SPACING = 0.4
+BALL_RADIUS = 25.0
+VIEW_SIZE = 600
+
+
+def _helix():
+    """The cut-field area's helix: 20 mm radius through the middle of a 512^3 CT, steps of 0.5 mm."""
+    center_mm = np.array([84.0, 84.0, 84.0])
+    angles = np.arange(STROKE_POSES + 1) * 0.5 / 20.0
+    return [center_mm + np.array([20.0 * np.cos(t), 20.0 * np.sin(t), 0.2 * t]) for t in angles]
+
+
+def _percentiles_ms(times_s):
+    return {q: 1000.0 * float(np.percentile(times_s, q)) for q in (50, 99)}
+
+
+def _strokes(machine) -> list[dict]:
+    dims = [512, 512, 512]
+    poses = _helix()
+    matrices = []
+    for pose in poses:
+        matrix = vtk.vtkMatrix4x4()
+        for axis in range(3):
+            matrix.SetElement(axis, 3, float(pose[axis]))
+        matrices.append(matrix)
+
+    def sphere_times():
+        field = slicer.vtkVolumeCutField()
+        field.Initialize(dims, grid_matrix(0.33, dims), 2)
+        times, cpu = [], []
+        field.BeginStroke()
+        for p0, p1 in zip(poses[:-1], poses[1:]):
+            start, start_cpu = time.perf_counter(), time.thread_time()
+            field.CutCapsule(p0, p1, 2.5)
+            times.append(time.perf_counter() - start)
+            cpu.append(time.thread_time() - start_cpu)
+        field.EndStroke()
+        return times, cpu
+
+    def tool_times(tool):
+        field = slicer.vtkVolumeCutField()
+        field.Initialize(dims, grid_matrix(0.33, dims), 2)
+        times, cpu = [], []
+        field.BeginStroke()
+        for m0, m1 in zip(matrices[:-1], matrices[1:]):
+            start, start_cpu = time.perf_counter(), time.thread_time()
+            field.CutToolSweep(tool, m0, m1)
+            times.append(time.perf_counter() - start)
+            cpu.append(time.thread_time() - start_cpu)
+        field.EndStroke()
+        return times, cpu
+
+    cylinder = slicer.vtkVolumeCutCylinderTool()
+    cylinder.SetRadius(2.5)
+    cylinder.SetLength(5.0)
+    disk = slicer.vtkVolumeCutCylinderTool()
+    disk.SetRadius(10.0)
+    disk.SetLength(0.5)
+    # Wall time, and the calling thread's processor time (what the stroke
+    # costs when the shared machine's other jobs do not preempt it).
+    sphere_wall, sphere_cpu = (_percentiles_ms(t) for t in sphere_times())
+    results = []
+    for name, tool in (("2.5 x 5 mm cylindrical burr", cylinder), ("20 mm disk saw 0.5 mm thick", disk)):
+        wall, cpu = (_percentiles_ms(t) for t in tool_times(tool))
+        for q in (50, 99):
+            results.append(measurement(
+                f"stroke of a {name} moving 0.5 mm, 0.33 mm voxels, factor 2, one core, wall time: p{q}", wall[q], "ms",
+                "the 5 mm spherical burr's stroke over the same poses, same run", sphere_wall[q], STROKE_POSES, machine))
+            results.append(measurement(
+                f"the same stroke, processor time of the calling thread: p{q}", cpu[q], "ms",
+                "the spherical burr's stroke, processor time, same run", sphere_cpu[q], STROKE_POSES, machine))
+    return results
+
+
+def _ball_scene():
+    application = HeadlessSlicer()
+    k, j, i = np.ogrid[: CT_DIMENSIONS[2], : CT_DIMENSIONS[1], : CT_DIMENSIONS[0]]
+    half = [(n - 1) / 2.0 for n in CT_DIMENSIONS]
+    r2 = ((i - half[0]) ** 2 + (j - half[1]) ** 2 + (k - half[2]) ** 2) * CT_SPACING**2
+    ct = np.where(r2 < BALL_RADIUS**2, 1200, -1000).astype(np.int16)
+    ijk_to_ras = np.diag([CT_SPACING, CT_SPACING, CT_SPACING, 1.0])
+    ijk_to_ras[:3, 3] = [-h * CT_SPACING for h in half]
+    volume = nodes.create_scalar_volume_node(application.scene, ct, ijk_to_ras, "BoneBall")
+    logic = application.volume_cutting_logic
+    cut_node = logic.AddVolumeCutNode(volume, None)
+    cut_node.SetSurfaceIsoValue(300.0)
+    # The ball's left pole, drilled along +x: the session works beside it.
+    plan = SimpleNamespace(entry=np.array([-BALL_RADIUS, 0.0, 0.0]), direction=np.array([1.0, 0.0, 0.0]),
+                           surface_radius=2.0)
+    return application, cut_node, plan
+
+
+def _replay(application, cut_node, plan, out_dir, frame):
+    application.volume_cutting_logic.ClearCut(cut_node)
+    return hapticsjob.run(application, cut_node, plan, out_dir, frame=frame)
+
+
+def _contact_ratio(cut_node, out_dir, machine) -> list[dict]:
+    """Sub-voxel contact (82 points) against whole-voxel contact at the replay's proxy positions, same calls."""
+    model = hapticsjob.force_model(cut_node, sphere_radius=2.0)
+    if model is None:
+        raise RuntimeError("the force model could not be prepared (see the log)")
+    anatomy = cut_node.GetAnatomyVolumeNode()
+    ijk_to_ras = vtk.vtkMatrix4x4()
+    anatomy.GetIJKToRASMatrix(ijk_to_ras)
+    cutter = slicer.vtkBinaryVoxelCutter()
+    cutter.Initialize(list(anatomy.GetImageData().GetDimensions()), ijk_to_ras)
+    recording = slicer.vtkHapticRecorder()
+    if not recording.ReadFile(str(out_dir / "haptic_replay.vchr")):
+        raise RuntimeError("the replayed session could not be read back (see the log)")
+    positions = []
+    for n in range(recording.GetNumberOfTicks()):
+        if recording.GetTickDrilling(n):
+            proxy = [0.0, 0.0, 0.0]
+            recording.GetTickProxy(n, proxy)
+            cutter.CutCapsule(proxy, proxy, 2.0)
+            positions.append(proxy)
+    force = [0.0, 0.0, 0.0]
+    sub_voxel, whole_voxel = [], []
+    contacts = 0
+    for _ in range(3):
+        for position in positions:
+            start = time.perf_counter()
+            contacts += model.ComputeContactForce(position, force) > 0
+            middle = time.perf_counter()
+            model.CountWholeVoxelContacts(position, cutter)
+            whole_voxel.append(time.perf_counter() - middle)
+            sub_voxel.append(middle - start)
+    sub = {q: 1e6 * float(np.percentile(sub_voxel, q)) for q in (50, 99)}
+    whole = {q: 1e6 * float(np.percentile(whole_voxel, q)) for q in (50, 99)}
+    return [measurement(
+        f"contact of the burr's 82 shell points against the CT iso-surface minus the cut field, "
+        f"at the {len(positions)} drilling proxy positions of the replay ({contacts // 3} in contact), from Python: p{q}",
+        sub[q], "us", "whole-voxel contact test of the same points (nearest voxel, whole-voxel removal), same calls",
+        whole[q], len(sub_voxel), machine) for q in (50, 99)], whole_voxel
+
+
+def _first_call(cut_node, position) -> float:
+    """The first force-model step after Prepare at a pose in contact, drill on (s)."""
+    model = hapticsjob.force_model(cut_node, sphere_radius=2.0)
+    model.Reset([position[0] - 3.0, position[1], position[2]])
+    start = time.perf_counter()
+    model.Step(position, 0.001, True)
+    return time.perf_counter() - start
+
+
+def haptics(repeats: int) -> list[dict]:
+    del repeats  # every stroke and tick is one repeat
+    results = []
+    application, cut_node, plan = _ball_scene()
+    view = application.create_3d_view(VIEW_SIZE, VIEW_SIZE)
+    view.look_at([0.0, 0.0, 0.0], direction=(-1.0, 0.0, 0.0), distance=4.0 * BALL_RADIUS)
+    view.render()
+    machine = machine_description(opengl_renderer_name(view.render_window))
+    machine["note"] = ("shared machine: 2 cores shared with other jobs (compilers, tests) and no GPU; "
+                       "rendering by Mesa llvmpipe on the CPU")
+    results += _strokes(machine)
+
+    with tempfile.TemporaryDirectory() as directory:
+        out_dir = Path(directory)
+        frames = {"n": 0}
+
+        def render():
+            view.render()
+            frames["n"] += 1
+
+        rendering = _replay(application, cut_node, plan, out_dir, render)
+        quiet = _replay(application, cut_node, plan, out_dir, None)
+        contact_rows, whole_voxel_s = _contact_ratio(cut_node, out_dir, machine)
+        surface = np.array(quiet["surface_ras_mm"])
+        first_s = _first_call(cut_node, surface + 1.0 * plan.direction)
+
+    what = (f"one haptic tick at 1 kHz (device read, 82-point contact, force, proxy, cut stroke of a 4 mm burr, "
+            f"recording) while the 3D view renders continuously in the main thread "
+            f"({rendering['display_frames']} frames in {rendering['wall_s']} s)")
+    baseline = "the same tick with the main thread only updating the scene at 60 Hz, same run"
+    for label, key in (("p50", "tick_us_p50"), ("p99", "tick_us_p99"), ("max", "tick_us_max")):
+        results.append(measurement(f"{what}: {label}", rendering[key], "us", f"{baseline}: {label}", quiet[key],
+                                   rendering["ticks_run"], machine))
+    # The haptic thread's own CPU clock over the same ticks: the tick's
+    # compute without the preemption that this shared machine adds to its wall time.
+    for label, key in (("p50", "tick_cpu_us_p50"), ("p99", "tick_cpu_us_p99"), ("max", "tick_cpu_us_max")):
+        results.append(measurement(
+            f"the same tick, processor time of the haptic thread while rendering: {label}", rendering[key], "us",
+            f"{baseline}, processor time: {label}", quiet[key], rendering["ticks_run"], machine))
+    results.append(measurement(
+        "the first force-model step after Prepare, at a pose in contact, drill on (from Python)", 1e6 * first_s, "us",
+        "the loop's tick p50 without rendering (above)", quiet["tick_us_p50"], 1, machine))
+    results.append(measurement(
+        "haptic loop period jitter at 1 kHz while the 3D view renders continuously: p99",
+        rendering["period_jitter_us_p99"], "us", "the same without rendering, same run: p99",
+        quiet["period_jitter_us_p99"], rendering["ticks_run"], machine))
+    results.append(measurement(
+        f"haptic loop overruns (ticks ending after their deadline) of {rendering['ticks_run']} while rendering",
+        rendering["overruns"], "ticks", "the same without rendering, same run", quiet["overruns"], 1, machine))
+    results.append(measurement(
+        "one haptic tick (loop-timed p50, without rendering) against one whole-voxel contact test of the same "
+        "82 points (Python-timed p50)", quiet["tick_us_p50"], "us",
+        "whole-voxel contact test p50 (below)", 1e6 * float(np.percentile(whole_voxel_s, 50)), quiet["ticks_run"],
+        machine))
+    results += contact_rows
+    for row in results:
+        row["real_time_priority"] = rendering["real_time_priority"]
+    results.append(measurement(
+        "cut volume of the replayed session while rendering (mm^3)", rendering["removed_volume_mm3"], "mm^3",
+        "the same session without rendering (determinism: ratio 1)", quiet["removed_volume_mm3"], 1, machine))
+    return results

@@ -1,0 +1,225 @@
+"""A haptic drilling session, recorded and replayed through the full haptic path.
+
+The main job calls :func:`run` once the mastoidectomy is drilled. A drilling
+session is written as a recording of device input (``haptic_session.vchr``):
+a hand that brings a 4 mm cutting burr to the bone beside the cavity, presses
+the foot switch and pushes into the bone, then lets go and withdraws. The
+recording is read back by a replay device and played through what a real
+device goes through: the haptic loop on its own thread at 1 kHz, the force
+model on the CT's iso-surface minus the cut field, strokes cut into the cut
+node's field by the haptic thread, and, at display rate on this thread, the
+tool node moved and the cut node's events sent (``vtkSlicerVolumeCuttingHapticSession``).
+The forces felt are recorded too (``haptic_replay.vchr``).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import slicer
+import vtk
+
+from ..config import toolconfig
+from ..cutting import recording
+
+#: The tool the session drills with.
+BURR_PRESET = "Cutting burr 4 mm"
+#: Where the hand starts: this far (mm) outside the bone, on the approach.
+STANDOFF_MM = 10.0
+#: Phases of the hand's motion: seconds, and where the hand is at their end
+#: (mm along the approach from the start), with the drill pedal down or not.
+PHASES = (
+    (1.2, 12.0, False),  # to the bone (first contact at 10 mm)
+    (2.5, 17.0, True),   # pedal down, pushing into the bone
+    (0.8, 0.0, False),   # pedal up, back out
+)
+RATE_HZ = 1000.0
+DISPLAY_PERIOD_S = 1.0 / 60.0
+
+
+def force_model(cut_node, sphere_radius=None):
+    """A force model on what the cut node draws (its CT's iso-surface minus its cut field), prepared; None if it cannot be."""
+    anatomy = cut_node.GetAnatomyVolumeNode()
+    ijk_to_ras = vtk.vtkMatrix4x4()
+    anatomy.GetIJKToRASMatrix(ijk_to_ras)
+    model = slicer.vtkHapticForceModel()
+    model.SetAnatomy(anatomy.GetImageData(), ijk_to_ras)
+    model.SetSurfaceIsoValue(cut_node.GetSurfaceIsoValue())
+    model.SetCutField(cut_node.GetCutField())
+    if sphere_radius is not None:
+        model.SetSphereRadius(sphere_radius)
+    return model if model.Prepare() else None
+
+
+def _first_solid(cut_node, start, direction, length=60.0, step=0.1):
+    """The first point of the line that is solid as the renderer draws it (None if none)."""
+    probe = force_model(cut_node)
+    if probe is None:
+        return None
+    for t in np.arange(0.0, length, step):
+        point = start + t * direction
+        if probe.IsSolid(point.tolist()):
+            return point
+    return None
+
+
+def target_beside(cut_node, plan) -> tuple[np.ndarray, np.ndarray, str]:
+    """A point of the bone surface beside the planned cavity, and the approach direction.
+
+    Falls back to the cavity's entry when no bone is found there.
+    """
+    direction = np.asarray(plan.direction, dtype=float)
+    direction /= np.linalg.norm(direction)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(direction[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    across = np.cross(direction, helper)
+    along = np.cross(direction, across / np.linalg.norm(across))
+    beside = np.asarray(plan.entry, dtype=float) + (plan.surface_radius + 6.0) * along
+    surface = _first_solid(cut_node, beside - 30.0 * direction, direction)
+    if surface is not None:
+        return surface, direction, "bone surface beside the cavity"
+    return np.asarray(plan.entry, dtype=float), direction, "the cavity's entry (no bone found beside it)"
+
+
+def active_burr(scene, cut_node):
+    """The cut node's active tool, or a new cutting burr made its active tool."""
+    tool = cut_node.GetActiveToolNode()
+    if tool is not None:
+        return tool, False
+    preset = next(p for p in toolconfig.load_presets() if p.name == BURR_PRESET)
+    tool = toolconfig.create_tool_node(scene, toolconfig.from_preset(preset), name="Haptic burr")
+    cut_node.SetAndObserveActiveToolNodeID(tool.GetID())
+    return tool, True
+
+
+def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
+    """The hand's input, tick by tick, as a recording a replay device reads; returns its ticks."""
+    recorder = slicer.vtkHapticRecorder()
+    ticks = int(round(sum(seconds for seconds, _, _ in PHASES) * RATE_HZ))
+    recorder.SetCapacity(ticks)
+    recorder.SetRate(RATE_HZ)
+    recorder.GetCapabilities().DeepCopy(capabilities)
+    position = 0.0
+    identity = [1.0, 0.0, 0.0, 0.0]
+    for seconds, end, pedal in PHASES:
+        count = int(round(seconds * RATE_HZ))
+        for tick in range(count):
+            depth = position + (end - position) * (tick + 1) / count
+            recorder.AppendInput((depth * direction).tolist(), identity, 0, 1 if pedal else 0, True)
+        position = end
+    if not recorder.WriteFile(str(path)):
+        raise RuntimeError(f"the haptic recording could not be written to {path} (see the log)")
+    return recorder.GetNumberOfTicks()
+
+
+def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
+    """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
+
+    ``frame``, if given, is called at each display frame after the session's
+    update (a view's render: the views draw the field while the haptic thread
+    cuts it); otherwise this thread sleeps a display period between updates.
+    """
+    logic = application.volume_cutting_logic
+    scene = application.scene
+    out_dir = Path(out_dir)
+    surface, direction, where = target_beside(cut_node, plan)
+    start = surface - STANDOFF_MM * direction
+    tool, created = active_burr(scene, cut_node)
+    # The handpiece held along the approach, shaft outwards: a 3-DOF device
+    # moves the tool and keeps this orientation.
+    pose = vtk.vtkMatrix4x4()
+    rotation = recording.frame_along(direction)
+    for row in range(3):
+        for column in range(3):
+            pose.SetElement(row, column, float(rotation[row, column]))
+        pose.SetElement(row, 3, float(start[row]))
+    tool.GetParentTransformNode().SetMatrixTransformToParent(pose)
+
+    # The recording: device input only (what a device gives), with the
+    # capabilities of the device it stands for (the Falcon's, as the virtual device's).
+    recording_path = out_dir / "haptic_session.vchr"
+    ticks = write_recording(recording_path, direction, slicer.vtkVirtualHapticDevice().GetCapabilities())
+
+    replay = slicer.vtkReplayHapticDevice()
+    if not replay.ReadFile(str(recording_path)):
+        raise RuntimeError(f"the haptic recording {recording_path} could not be read back (see the log)")
+    session = slicer.vtkSlicerVolumeCuttingHapticSession()
+    session.SetLogic(logic)
+    loop = session.GetLoop()
+    loop.SetRate(RATE_HZ)
+    replayed = slicer.vtkHapticRecorder()
+    replayed.SetCapacity(ticks + 1000)
+    loop.SetRecorder(replayed)
+    removed_before = logic.GetRemovedVolume(cut_node)
+    events = {"cut_modified": 0}
+    observer = cut_node.AddObserver(slicer.vtkMRMLVolumeCutNode.CutModifiedEvent,
+                                    lambda caller, event: events.__setitem__("cut_modified", events["cut_modified"] + 1))
+    started = time.perf_counter()
+    if not session.Start(cut_node, replay):
+        cut_node.RemoveObserver(observer)
+        raise RuntimeError("the haptic session could not start (see the log)")
+    frames = 0
+    try:
+        while not replay.IsFinished():
+            if frame is None:
+                time.sleep(DISPLAY_PERIOD_S)
+            session.Update()
+            if frame is not None:
+                frame()
+            frames += 1
+    finally:
+        session.Stop()
+        cut_node.RemoveObserver(observer)
+    wall_s = time.perf_counter() - started
+    replayed.WriteFile(str(out_dir / "haptic_replay.vchr"))
+
+    magnitudes = []
+    proxies = []
+    drilling = []
+    for n in range(replayed.GetNumberOfTicks()):
+        force = [0.0, 0.0, 0.0]
+        replayed.GetTickForce(n, force)
+        magnitudes.append(float(np.linalg.norm(force)))
+        proxy = [0.0, 0.0, 0.0]
+        replayed.GetTickProxy(n, proxy)
+        proxies.append(proxy)
+        drilling.append(bool(replayed.GetTickDrilling(n)))
+    magnitudes = np.array(magnitudes)
+    drilling = np.array(drilling, dtype=bool)
+    proxies = np.array(proxies)
+    # How deep the burr's centre went past the surface it started from.
+    deepest = float(np.max((proxies - surface) @ direction)) if len(proxies) else 0.0
+    tool_pose = vtk.vtkMatrix4x4()
+    tool.GetParentTransformNode().GetMatrixTransformToWorld(tool_pose)
+    return {
+        "target": where,
+        "surface_ras_mm": [round(float(v), 2) for v in surface],
+        "approach": [round(float(v), 3) for v in direction],
+        "tool": tool.GetName() + (" (created)" if created else ""),
+        "recording": str(recording_path),
+        "replay_recording": str(out_dir / "haptic_replay.vchr"),
+        "device": replay.GetCapabilities().GetModelName() or "replay",
+        "ticks_recorded": ticks,
+        "ticks_run": int(loop.GetNumberOfTicks()),
+        "ticks_drilling": int(drilling.sum()),
+        "cut_strokes": loop.GetNumberOfCutStrokes(),
+        "drill_presses": loop.GetNumberOfDrillPresses(),
+        "display_frames": frames,
+        "cut_modified_events": events["cut_modified"],
+        "removed_volume_mm3": round(logic.GetRemovedVolume(cut_node) - removed_before, 2),
+        "burr_centre_depth_below_surface_mm": round(deepest, 2),
+        "tool_node_moved_to_ras_mm": [round(tool_pose.GetElement(axis, 3), 2) for axis in range(3)],
+        "force_max_n": round(float(magnitudes.max(initial=0.0)), 3),
+        "force_mean_while_drilling_n": round(float(magnitudes[drilling].mean()) if drilling.any() else 0.0, 3),
+        "tick_us_p50": round(loop.GetTickDurationPercentile(50.0), 1),
+        "tick_us_p99": round(loop.GetTickDurationPercentile(99.0), 1),
+        "tick_us_max": round(loop.GetMaximumTickDuration(), 1),
+        "tick_cpu_us_p50": round(loop.GetTickProcessorTimePercentile(50.0), 1),
+        "tick_cpu_us_p99": round(loop.GetTickProcessorTimePercentile(99.0), 1),
+        "tick_cpu_us_max": round(loop.GetTickProcessorTimePercentile(100.0), 1),
+        "period_jitter_us_p99": round(loop.GetPeriodJitterPercentile(99.0), 1),
+        "overruns": int(loop.GetNumberOfOverruns()),
+        "real_time_priority": bool(loop.GetRealTimePriority()),
+        "wall_s": round(wall_s, 2),
+    }
