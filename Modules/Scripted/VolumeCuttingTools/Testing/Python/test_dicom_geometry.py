@@ -260,8 +260,11 @@ def test_zip_with_several_series_chooses_the_ct_and_names_the_others(scene, tmp_
         dataset.SeriesDescription = "T1"
         dataset.save_as(file)
     path = unpacked_upload(tmp_path, zip_folder(tmp_path / "export", tmp_path / "export.zip"))
+    # A job names the series it means; the application chooses and says so.
+    with pytest.raises(owndata.InputError, match="holds 3 DICOM series .*Give one file"):
+        owndata.load_ct(scene, path)
     messages = []
-    volume = owndata.load_ct(scene, path, messages=messages)
+    volume = owndata.load_ct(scene, path, messages=messages, choose_series=True)
     note = next(m for m in messages if "chose the CT" in m)
     assert "series 3 'Head tilted' (CT, 20 files), the one with the most slices" in note
     assert "also present: " in note and "series 1 'Head tilted' (CT, 3 files)" in note and "series 9 'T1' (MR, 30 files)" in note

@@ -245,17 +245,19 @@ def _check_hounsfield(volume, source, messages):
 # --------------------------------------------------------------------------- DICOM series
 
 
-def find_dicom_series(path, messages=None) -> tuple[list[Path], dict]:
+def find_dicom_series(path, messages=None, choose_series=False) -> tuple[list[Path], dict]:
     """Return the image files of the DICOM series at ``path`` (a folder, or one file of the series).
 
     Returns (files, info): the files in name order (the reader sorts them by
     position) and the series' Modality, SeriesDescription and SeriesInstanceUID.
     A folder is searched with its subfolders (through its DICOMDIR if it has
-    one, as CD and PACS exports are laid out); of several series the CT with
-    the most slices is taken, with a message in ``messages`` naming it and the
-    others. Damaged DICOM files are skipped and named in ``messages``.
+    one, as CD and PACS exports are laid out). Of several series, with
+    ``choose_series`` the CT with the most slices is taken, with a message in
+    ``messages`` naming it and the others (the application, which shows it);
+    without, the folder is refused (a job names the series it means).
+    Damaged DICOM files are skipped and named in ``messages``.
     Raises ``InputError`` for a folder without DICOM images, or with several
-    series of which none has the most CT slices (name one file of the one you mean).
+    series not to be chosen from (name one file of the one you mean).
     """
     path = Path(path)
     folder = path if path.is_dir() else path.parent
@@ -281,9 +283,12 @@ def find_dicom_series(path, messages=None) -> tuple[list[Path], dict]:
             raise InputError(folder, "contains no DICOM image files (its subfolders and any DICOMDIR searched too)",
                              f"Give {_FORMATS}; for DICOM, the folder that holds the slice files of one series.")
         info, note = dicomimport.choose_series(series)
-        if info is None:
-            raise InputError(folder, f"holds {len(series)} DICOM series and no single CT series has the most slices "
-                                     f"({note})", "Give one file of the series you mean instead of the folder.")
+        if len(series) > 1 and (info is None or not choose_series):
+            listing = "; ".join(dicomimport.describe_series(entry) + f", e.g. {entry['files'][0].name}"
+                                for entry in series.values())
+            why = " and no single CT series has the most slices" if choose_series else ""
+            raise InputError(folder, f"holds {len(series)} DICOM series{why} ({listing})",
+                             "Give one file of the series you mean instead of the folder.")
         if note:
             _warn(messages, f"{folder}: {note}")
     return info["files"], {key: info[key] for key in ("Modality", "SeriesDescription", "SeriesInstanceUID")}
@@ -297,7 +302,7 @@ def _series_label(info, files) -> str:
 # --------------------------------------------------------------------------- the CT
 
 
-def load_ct(scene, path, name=None, messages=None):
+def load_ct(scene, path, name=None, messages=None, choose_series=False):
     """Load the user's CT into ``scene`` and return its ``vtkMRMLScalarVolumeNode``.
 
     Args:
@@ -306,11 +311,17 @@ def load_ct(scene, path, name=None, messages=None):
             or MetaImage file.
         name: the node's name (default: the file's base name, or the series
             description).
-        messages: optional list that receives warnings (strings).
+        messages: optional list that receives warnings (strings), among them
+            what was corrected in a tilted or unevenly spaced DICOM series
+            (resampled onto a regular grid, see ``dicomimport``).
+        choose_series: of a folder with several DICOM series, take the CT
+            with the most slices (saying so in ``messages``) instead of refusing.
 
     Raises:
         InputError: a missing path, a folder without DICOM, a file that is
-            not an image, a 2D image, or values that cannot be Hounsfield units.
+            not an image, a 2D image, values that cannot be Hounsfield units,
+            or a DICOM series that cannot be one volume (slices in several
+            orientations, two at one position).
             The scene is left as it was.
     """
     path = Path(path).expanduser()
@@ -321,7 +332,7 @@ def load_ct(scene, path, name=None, messages=None):
             raise InputError(path, "is a segmentation, not a CT",
                              "Give it as the segmentation (--segmentation) and the CT itself as the CT.")
         if path.is_dir() or not _has_extension(path, VOLUME_EXTENSIONS):
-            files, info = find_dicom_series(path, messages)
+            files, info = find_dicom_series(path, messages, choose_series)
             if info["Modality"] and info["Modality"] != "CT":
                 raise InputError(path, f"is a {info['Modality']} series, not CT",
                                  "Drilling needs a CT in Hounsfield units; give the CT series of the patient.")
