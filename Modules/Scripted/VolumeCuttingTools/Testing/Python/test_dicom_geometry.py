@@ -287,3 +287,21 @@ def test_the_app_loads_a_nested_zip_and_shows_the_correction(tmp_path):
         assert any("gantry tilt 18.5° corrected" in w for w in session.warnings), session.warnings
     finally:
         session.close()
+
+
+def test_the_main_job_reports_the_correction_in_its_summary(tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    write_ball_series(tmp_path / "SE0003")
+    module_dir = Path(__file__).resolve().parents[2]
+    result = subprocess.run([sys.executable, "-m", "VolumeCuttingLib.jobs.mainjob", "--ct", str(tmp_path / "SE0003"),
+                             "--out", str(tmp_path / "out"), "--size", "64x48"],
+                            capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(module_dir)), timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    warnings = summary["own_data"]["warnings"]
+    assert any("gantry tilt 18.5° corrected and 3 uneven gap(s) between slices (4.2, 1.1, 7.4 mm" in w
+               for w in warnings), warnings
