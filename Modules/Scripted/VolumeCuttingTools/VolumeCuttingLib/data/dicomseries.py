@@ -65,10 +65,6 @@ def write_ct_series(volume_node, folder, patient_name: str = "Anonymous^Patient"
         ValueError: the node has no voxels or more than one component, or its
             i and j axes are not orthogonal (DICOM cannot describe a sheared grid).
     """
-    import pydicom
-    from pydicom.dataset import FileMetaDataset
-    from pydicom.uid import ExplicitVRLittleEndian, PYDICOM_IMPLEMENTATION_UID, generate_uid
-
     name = volume_node.GetName() or "volume"
     image = volume_node.GetImageData()
     if image is None or image.GetNumberOfPoints() == 0:
@@ -77,14 +73,43 @@ def write_ct_series(volume_node, folder, patient_name: str = "Anonymous^Patient"
         raise ValueError(f"volume node {name!r} has {image.GetNumberOfScalarComponents()} components; "
                          "a CT series holds one value a voxel")
     array = nodes.array_from_volume_node(volume_node)
-    ijk_to_lps = np.eye(4)
-    ijk_to_lps[:3, :] = RAS_TO_LPS @ nodes.volume_node_ijk_to_ras(volume_node)[:3, :]
-    axes = ijk_to_lps[:3, :3]
+    ijk_to_ras = nodes.volume_node_ijk_to_ras(volume_node)
+    axes = ijk_to_ras[:3, :3]
     spacing = np.linalg.norm(axes, axis=0)
     directions = axes / spacing
     if abs(float(directions[:, 0] @ directions[:, 1])) > 1e-6:
         raise ValueError(f"volume node {name!r}: its i and j axes are not orthogonal; "
                          "DICOM image planes must be rectangular")
+    positions = [ijk_to_ras[:3, 3] + k * axes[:, 2] for k in range(array.shape[0])]
+    return write_ct_slices(array, positions, directions[:, 0], directions[:, 1], spacing[:2], folder,
+                           patient_name=patient_name, patient_id=patient_id,
+                           series_description=series_description or name, series_number=series_number,
+                           slice_spacing=float(spacing[2]))
+
+
+def write_ct_slices(slices, positions_ras, row_ras, column_ras, pixel_spacing, folder,
+                    patient_name: str = "Anonymous^Patient", patient_id: str = "VC0001",
+                    series_description: str = "CT", series_number: int = 1,
+                    slice_spacing: float | None = None) -> list[Path]:
+    """Write ``slices`` (``[k, j, i]``, HU) as one DICOM CT series whose slice k lies at ``positions_ras[k]``.
+
+    Each slice's first voxel is at ``positions_ras[k]`` (RAS), its rows run
+    along ``row_ras`` (i) and its columns along ``column_ras`` (j), with
+    ``pixel_spacing`` (along i, along j). The positions may step off the
+    slice normal (a gantry tilt) and unevenly (gaps, missing slices), as real
+    scanners write them; SpacingBetweenSlices is written only when
+    ``slice_spacing`` is given. Returns the paths (``slice_0000.dcm``, ...) in k order.
+    """
+    import pydicom
+    from pydicom.dataset import FileMetaDataset
+    from pydicom.uid import ExplicitVRLittleEndian, PYDICOM_IMPLEMENTATION_UID, generate_uid
+
+    array = np.asarray(slices)
+    row_lps = RAS_TO_LPS @ np.asarray(row_ras, dtype=float)
+    column_lps = RAS_TO_LPS @ np.asarray(column_ras, dtype=float)
+    if abs(float(row_lps @ column_lps)) > 1e-6:
+        raise ValueError("the row and column directions are not orthogonal; DICOM image planes must be rectangular")
+    normal_lps = np.cross(row_lps, column_lps)
 
     slope, intercept = rescale_for_int16(array)
     stored = np.clip(np.rint((array.astype(np.float64) - intercept) / slope), _INT16.min, _INT16.max).astype("<i2")
@@ -93,7 +118,7 @@ def write_ct_series(volume_node, folder, patient_name: str = "Anonymous^Patient"
     folder.mkdir(parents=True, exist_ok=True)
     now = datetime.datetime.now()
     study_uid, series_uid, frame_uid = generate_uid(), generate_uid(), generate_uid()
-    orientation = [_decimal_string(v) for v in np.concatenate([directions[:, 0], directions[:, 1]])]
+    orientation = [_decimal_string(v) for v in np.concatenate([row_lps, column_lps])]
     window_center, window_width = 400.0, 2000.0  # a bone window
     paths = []
     for k in range(array.shape[0]):
@@ -121,14 +146,15 @@ def write_ct_series(volume_node, folder, patient_name: str = "Anonymous^Patient"
         ds.StudyID = "1"
         ds.SeriesNumber = series_number
         ds.InstanceNumber = k + 1
-        ds.SeriesDescription = series_description or name
-        position = ijk_to_lps @ np.array([0.0, 0.0, float(k), 1.0])
-        ds.ImagePositionPatient = [_decimal_string(v) for v in position[:3]]
+        ds.SeriesDescription = series_description
+        position = RAS_TO_LPS @ np.asarray(positions_ras[k], dtype=float)
+        ds.ImagePositionPatient = [_decimal_string(v) for v in position]
         ds.ImageOrientationPatient = orientation
-        ds.SliceLocation = _decimal_string(float(position[:3] @ np.cross(directions[:, 0], directions[:, 1])))
-        ds.PixelSpacing = [_decimal_string(spacing[1]), _decimal_string(spacing[0])]  # rows (j), columns (i)
-        ds.SliceThickness = _decimal_string(spacing[2])
-        ds.SpacingBetweenSlices = _decimal_string(spacing[2])
+        ds.SliceLocation = _decimal_string(float(position @ normal_lps))
+        ds.PixelSpacing = [_decimal_string(pixel_spacing[1]), _decimal_string(pixel_spacing[0])]  # rows (j), columns (i)
+        if slice_spacing is not None:
+            ds.SliceThickness = _decimal_string(slice_spacing)
+            ds.SpacingBetweenSlices = _decimal_string(slice_spacing)
         ds.SamplesPerPixel = 1
         ds.PhotometricInterpretation = "MONOCHROME2"
         ds.Rows, ds.Columns = array.shape[1], array.shape[2]

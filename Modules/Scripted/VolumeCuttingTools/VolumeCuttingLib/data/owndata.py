@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scene import nodes
+from . import dicomimport
 
 VOLUME_EXTENSIONS = (".nrrd", ".nhdr", ".nii", ".nii.gz", ".mha", ".mhd")
 SEGMENTATION_EXTENSION = ".seg.nrrd"
@@ -244,60 +245,64 @@ def _check_hounsfield(volume, source, messages):
 # --------------------------------------------------------------------------- DICOM series
 
 
-def _dicom_header(path: Path):
-    import pydicom
-
-    try:
-        return pydicom.dcmread(path, stop_before_pixels=True)
-    except (pydicom.errors.InvalidDicomError, OSError, ValueError, EOFError, KeyError, TypeError):
-        return None
-
-
-def find_dicom_series(path) -> tuple[list[Path], dict]:
+def find_dicom_series(path, messages=None, choose_series=False) -> tuple[list[Path], dict]:
     """Return the image files of the DICOM series at ``path`` (a folder, or one file of the series).
 
     Returns (files, info): the files in name order (the reader sorts them by
     position) and the series' Modality, SeriesDescription and SeriesInstanceUID.
-    Raises ``InputError`` for a folder without DICOM images or with several
-    image series (name one file of the one you mean).
+    A folder is searched with its subfolders (through its DICOMDIR if it has
+    one, as CD and PACS exports are laid out). Of several series, with
+    ``choose_series`` the CT with the most slices is taken, with a message in
+    ``messages`` naming it and the others (the application, which shows it);
+    without, the folder is refused (a job names the series it means).
+    Damaged DICOM files are skipped and named in ``messages``.
+    Raises ``InputError`` for a folder without DICOM images, or with several
+    series not to be chosen from (name one file of the one you mean).
     """
     path = Path(path)
     folder = path if path.is_dir() else path.parent
     chosen_uid = None
     if path.is_file():
-        header = _dicom_header(path)
+        header = dicomimport.read_header(path)
         if header is None or "Rows" not in header:
             raise InputError(path, "is not an image file this product reads (neither DICOM nor a volume file)",
                              f"Give {_FORMATS}.")
         chosen_uid = str(header.get("SeriesInstanceUID", ""))
-    series = {}
-    for candidate in sorted(p for p in folder.iterdir() if p.is_file()):
-        header = _dicom_header(candidate)
-        if header is None or "Rows" not in header:
-            continue  # DICOMDIR, structured reports, other files
-        uid = str(header.get("SeriesInstanceUID", ""))
-        entry = series.setdefault(uid, {"files": [], "Modality": str(header.get("Modality", "")),
-                                        "SeriesDescription": str(header.get("SeriesDescription", "")),
-                                        "SeriesInstanceUID": uid})
-        entry["files"].append(candidate)
-    if not series:
-        raise InputError(folder, "contains no DICOM image files",
-                         f"Give {_FORMATS}; for DICOM, the folder that holds the slice files of one series.")
-    if chosen_uid is None:
-        if len(series) > 1:
-            listing = "; ".join(f"{len(s['files'])} {s['Modality'] or '?'} files "
-                                f"'{s['SeriesDescription']}' (e.g. {s['files'][0].name})" for s in series.values())
-            raise InputError(folder, f"holds {len(series)} DICOM series ({listing})",
+        # One file names its series among the files beside it.
+        series = {}
+        for candidate in sorted(p for p in folder.iterdir() if p.is_file()):
+            other = dicomimport.read_header(candidate)
+            if other is not None and "Rows" in other and str(other.get("SeriesInstanceUID", "")) == chosen_uid:
+                series.setdefault(chosen_uid, {"files": [], "Modality": str(header.get("Modality", "")),
+                                               "SeriesDescription": str(header.get("SeriesDescription", "")),
+                                               "SeriesInstanceUID": chosen_uid})["files"].append(candidate)
+        info = series[chosen_uid]
+    else:
+        series = dicomimport.find_series(folder, messages)
+        if not series:
+            raise InputError(folder, "contains no DICOM image files (its subfolders and any DICOMDIR searched too)",
+                             f"Give {_FORMATS}; for DICOM, the folder that holds the slice files of one series.")
+        info, note = dicomimport.choose_series(series)
+        if len(series) > 1 and (info is None or not choose_series):
+            listing = "; ".join(dicomimport.describe_series(entry) + f", e.g. {entry['files'][0].name}"
+                                for entry in series.values())
+            why = " and no single CT series has the most slices" if choose_series else ""
+            raise InputError(folder, f"holds {len(series)} DICOM series{why} ({listing})",
                              "Give one file of the series you mean instead of the folder.")
-        chosen_uid = next(iter(series))
-    info = series[chosen_uid]
+        if note:
+            _warn(messages, f"{folder}: {note}")
     return info["files"], {key: info[key] for key in ("Modality", "SeriesDescription", "SeriesInstanceUID")}
+
+
+def _series_label(info, files) -> str:
+    """How messages name a series: its description, else its folder."""
+    return f"'{info['SeriesDescription']}'" if info["SeriesDescription"] else str(Path(files[0]).parent.name)
 
 
 # --------------------------------------------------------------------------- the CT
 
 
-def load_ct(scene, path, name=None, messages=None):
+def load_ct(scene, path, name=None, messages=None, choose_series=False):
     """Load the user's CT into ``scene`` and return its ``vtkMRMLScalarVolumeNode``.
 
     Args:
@@ -306,11 +311,17 @@ def load_ct(scene, path, name=None, messages=None):
             or MetaImage file.
         name: the node's name (default: the file's base name, or the series
             description).
-        messages: optional list that receives warnings (strings).
+        messages: optional list that receives warnings (strings), among them
+            what was corrected in a tilted or unevenly spaced DICOM series
+            (resampled onto a regular grid, see ``dicomimport``).
+        choose_series: of a folder with several DICOM series, take the CT
+            with the most slices (saying so in ``messages``) instead of refusing.
 
     Raises:
         InputError: a missing path, a folder without DICOM, a file that is
-            not an image, a 2D image, or values that cannot be Hounsfield units.
+            not an image, a 2D image, values that cannot be Hounsfield units,
+            or a DICOM series that cannot be one volume (slices in several
+            orientations, two at one position).
             The scene is left as it was.
     """
     path = Path(path).expanduser()
@@ -321,12 +332,26 @@ def load_ct(scene, path, name=None, messages=None):
             raise InputError(path, "is a segmentation, not a CT",
                              "Give it as the segmentation (--segmentation) and the CT itself as the CT.")
         if path.is_dir() or not _has_extension(path, VOLUME_EXTENSIONS):
-            files, info = find_dicom_series(path)
+            files, info = find_dicom_series(path, messages, choose_series)
             if info["Modality"] and info["Modality"] != "CT":
                 raise InputError(path, f"is a {info['Modality']} series, not CT",
                                  "Drilling needs a CT in Hounsfield units; give the CT series of the patient.")
             default_name = info["SeriesDescription"] or (path if path.is_dir() else path.parent).name
+            try:
+                stack = dicomimport.read_geometry(files)
+            except dicomimport.SeriesError as error:
+                raise InputError(path, f"is not one regular volume: {error.problem}", error.remedy + ".") from error
             volume, warnings = _read_volume(scene, "vtkMRMLScalarVolumeNode", files, name or default_name, path)
+            # ITK puts the slices on an even, untilted grid whatever their true positions.
+            warnings = [w for w in warnings if "Non uniform sampling" not in w] if stack is not None else warnings
+            if stack is not None:
+                try:
+                    correction = dicomimport.regularize(volume, stack, _series_label(info, files))
+                except dicomimport.SeriesError as error:
+                    raise InputError(path, f"cannot be put on a regular grid: {error.problem}",
+                                     error.remedy + ".") from error
+                if correction:
+                    _warn(messages, f"{path}: {correction}")
         else:
             volume, warnings = _read_volume(scene, "vtkMRMLScalarVolumeNode", [path], name or _base_name(path), path)
         _check_is_volume(volume, path, "CT")

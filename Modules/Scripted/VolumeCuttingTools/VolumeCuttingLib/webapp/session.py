@@ -217,7 +217,8 @@ class DrillSession:
                 volume, segmentation = phantom.create_phantom_nodes(self.scene, generated)
                 description = "Temporal-bone phantom"
             else:
-                volume = owndata.load_ct(self.scene, ct_path, messages=warnings)
+                # A CD or PACS export holds several series: take the CT and say so in the warnings.
+                volume = owndata.load_ct(self.scene, ct_path, messages=warnings, choose_series=True)
                 created.append(volume)
                 segmentation = None
                 if segmentation_path is not None:
