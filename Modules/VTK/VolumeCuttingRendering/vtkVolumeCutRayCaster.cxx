@@ -2,20 +2,18 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutRayCaster.h"
 
-// The stages of adaptive sampling, one private header each (Pflesser et al.):
-// 1 classification, 2 border location, 3 piece classification, 4 shading.
+// The stages of adaptive sampling along one ray are vtkVolumeCutRayMarcher's;
+// the inputs become the scene it reads through vtkVolumeCutSceneInputs.
 #include "vtkVolumeCutBorderLocator.h"
-#include "vtkVolumeCutCompositor.h"
 #include "vtkVolumeCutEmptySpace.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutLabelSmoothing.h"
 #include "vtkVolumeCutLocalizedUpdate.h"
 #include "vtkVolumeCutParallelFor.h"
-#include "vtkVolumeCutPieceClassifier.h"
+#include "vtkVolumeCutRayMarcher.h"
 #include "vtkVolumeCutRayResult.h"
 #include "vtkVolumeCutRayScene.h"
-#include "vtkVolumeCutSampleClassifier.h"
-#include "vtkVolumeCutSurfaceShader.h"
+#include "vtkVolumeCutSceneInputs.h"
 
 #include <vtkColorTransferFunction.h>
 #include <vtkDataArray.h>
@@ -45,8 +43,6 @@
 vtkStandardNewMacro(vtkVolumeCutRayCaster);
 
 using vtkVolumeCutRayMath::Multiply4;
-using vtkVolumeCutRayMath::TransformPoint;
-using vtkVolumeCutRayMath::TransformVector;
 
 namespace
 {
@@ -119,11 +115,9 @@ struct vtkVolumeCutRayCaster::Internals
 };
 
 //------------------------------------------------------------------------------
-// One ray, from the eye through the pixel's centre: the stages of adaptive
-// sampling along it, or the compositor in composite mode.
+// One ray, from the eye through the pixel's centre, into its pixel (cleared first).
 void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqueLimit)
 {
-  const vtkVolumeCutRayScene& scene = this->Scene;
   const vtkIdType pixel = static_cast<vtkIdType>(y) * this->Width + x;
   vtkVolumeCutRayResult result;
   result.Color = &this->Color[4 * pixel];
@@ -138,151 +132,7 @@ void vtkVolumeCutRayCaster::Internals::CastRay(int x, int y, const double* opaqu
   *result.Source = SourceNone;
   *result.Segment = 0;
 
-  // The ray through the pixel's centre, from the near to the far plane.
-  const double ndcX = 2.0 * (x + 0.5) / this->Width - 1.0;
-  const double ndcY = 2.0 * (y + 0.5) / this->Height - 1.0;
-  const double nearH[4] = { ndcX, ndcY, -1.0, 1.0 };
-  const double farH[4] = { ndcX, ndcY, 1.0, 1.0 };
-  double nearW[4];
-  double farW[4];
-  Multiply4(this->NDCToWorld, nearH, nearW);
-  Multiply4(this->NDCToWorld, farH, farW);
-  vtkVolumeCutRay ray;
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    ray.OriginWorld[axis] = nearW[axis] / nearW[3];
-    ray.DirectionWorld[axis] = farW[axis] / farW[3] - ray.OriginWorld[axis];
-  }
-  ray.TEnd = vtkMath::Normalize(ray.DirectionWorld);
-  if (opaqueLimit)
-  {
-    ray.TEnd = std::min(ray.TEnd, *opaqueLimit);
-  }
-  for (int axis = 0; axis < 3; ++axis)
-  {
-    ray.View[axis] = -ray.DirectionWorld[axis];
-  }
-  TransformPoint(scene.WorldToIJK, ray.OriginWorld, ray.Origin);
-  TransformVector(scene.WorldToIJK, ray.DirectionWorld, ray.Direction);
-
-  const vtkVolumeCutSampleClassifier classifier(scene);
-  const vtkVolumeCutBorderLocator locator(scene, classifier);
-  const vtkVolumeCutSurfaceShader shader(scene, classifier);
-  // Entry and exit: the volume's box (sample domain), then the clip planes.
-  if (!locator.ClipToVolume(ray))
-  {
-    return;
-  }
-  const double* o = ray.Origin;
-  const double* d = ray.Direction;
-  const double tEnd = ray.TEnd;
-
-  // World length of one voxel step along this ray.
-  ray.VoxelsPerMillimetre = vtkMath::Norm(d);
-  const double step = scene.SampleDistance / ray.VoxelsPerMillimetre;
-  const bool composite = scene.BlendMode == CompositeBlend;
-  const vtkVolumeCutEmptySpace& emptySpace = scene.EmptySpace;
-  // Nothing visible in the sample's block: jump it to where the ray leaves it, unless
-  // that is within a step.
-  auto skipBlock = [&](vtkVolumeCutSample& sample) -> bool {
-    const double exit = std::min(emptySpace.Exit(sample.Index, d, sample.T) + 1e-9, tEnd);
-    if (!(exit > sample.T + step))
-    {
-      return false;
-    }
-    sample = vtkVolumeCutSample::At(o, d, exit);
-    classifier.EvaluateObject(sample);
-    return true;
-  };
-
-  if (composite)
-  {
-    const vtkVolumeCutCompositor compositor(scene, classifier, locator, shader);
-    vtkVolumeCutSample a = vtkVolumeCutSample::At(o, d, ray.TStart);
-    classifier.EvaluateObject(a);
-    classifier.EvaluateCuts(a);
-    int lastCutBorder = -1; // the cut whose border the next piece starts at
-    while (a.T < tEnd)
-    {
-      if (emptySpace.Empty(a.Index) && skipBlock(a))
-      {
-        classifier.EvaluateCuts(a);
-        lastCutBorder = -1;
-        continue;
-      }
-      vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
-      classifier.EvaluateObject(b);
-      if (compositor.Step(ray, a, b, lastCutBorder, result))
-      {
-        return;
-      }
-      a = b;
-    }
-    return;
-  }
-
-  // Iso-surface mode: samples every SampleDistance voxels, classified (step
-  // 1); between two, the borders and pieces (steps 2 and 3), the first
-  // visible piece shaded (step 4).
-  const vtkVolumeCutPieceClassifier pieces(classifier, locator, shader);
-  vtkVolumeCutSample a = vtkVolumeCutSample::At(o, d, ray.TStart);
-  classifier.EvaluateObject(a);
-  bool insideVisible = classifier.Visible(a);
-  if (insideVisible && shader.Enter(ray, a, ray.TStart, ray.EntrySource, result))
-  {
-    return;
-  }
-  while (a.T < tEnd)
-  {
-    if (a.Object == 0 && emptySpace.Empty(a.Index) && skipBlock(a))
-    {
-      insideVisible = classifier.Visible(a);
-      if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
-      {
-        return;
-      }
-      continue;
-    }
-    // Where nothing can show ahead, the ray jumps to the last sample on its
-    // sample grid before it may (the samples stay where a march without the
-    // jump puts them, so that the same grazing rays catch a surface's rim as
-    // on the GPU):
-    double clearUntil = a.T;
-    if (a.Object == 0)
-    {
-      // through cells where nothing visible can be, to the next that may
-      // hold a surface;
-      clearUntil = emptySpace.ExitEmptyCells(a.Index, d, a.T, tEnd);
-    }
-    else if (!insideVisible && a.CutsKnown)
-    {
-      // deep in a cavity, across the removed depth of this sample (the cut
-      // fields are distances, 1 mm per mm).
-      for (size_t n = 0; n < scene.CutFields.size(); ++n)
-      {
-        clearUntil = std::max(clearUntil, a.T - a.Distance[n]);
-      }
-    }
-    const double landing = a.T + std::floor((std::min(clearUntil, tEnd) - a.T) / step) * step;
-    if (landing > a.T + step)
-    {
-      a = vtkVolumeCutSample::At(o, d, landing);
-      classifier.EvaluateObject(a);
-      insideVisible = classifier.Visible(a);
-      if (insideVisible && shader.Enter(ray, a, a.T, SourceObject, result))
-      {
-        return;
-      }
-      continue;
-    }
-    vtkVolumeCutSample b = vtkVolumeCutSample::At(o, d, std::min(a.T + step, tEnd));
-    classifier.EvaluateObject(b);
-    if (pieces.Interval(ray, a, b, insideVisible, result))
-    {
-      return;
-    }
-    a = b;
-  }
+  vtkVolumeCutRayMarcher::Cast(this->Scene, this->NDCToWorld, this->Width, this->Height, x, y, opaqueLimit, result);
 }
 
 //------------------------------------------------------------------------------
@@ -538,82 +388,6 @@ void vtkVolumeCutRayCaster::GetSegmentImage(vtkImageData* image) const
   FillImage<vtkIntArray>(image, this->Impl->Width, this->Impl->Height, 1, this->Impl->Segment);
 }
 
-namespace
-{
-template <typename T>
-void CopyFirstComponent(const T* in, int stride, vtkIdType count, float* out)
-{
-  for (vtkIdType n = 0; n < count; ++n)
-  {
-    out[n] = static_cast<float>(in[n * stride]);
-  }
-}
-
-/// Which fraction blocks of the scene's grid hold a corner where \a fraction is above 0.
-void MarkNonZeroBlocks(const vtkVolumeCutRayScene& scene, vtkVolumeCutRayScene::FractionVolume& fraction, int maximumThreads)
-{
-  constexpr int size = vtkVolumeCutRayScene::FractionBlockSize;
-  const int* dims = scene.Dimensions;
-  int blocks[3];
-  scene.GetFractionBlockDimensions(blocks);
-  fraction.NonZeroBlocks.assign(static_cast<size_t>(blocks[0]) * blocks[1] * blocks[2], 0);
-  if (fraction.Values.size() != static_cast<size_t>(dims[0]) * dims[1] * dims[2])
-  {
-    fraction.NonZeroBlocks.clear(); // not on the grid: every block is read
-    return;
-  }
-  const vtkIdType sy = dims[0];
-  const vtkIdType sz = static_cast<vtkIdType>(dims[0]) * dims[1];
-  // Each voxel marks the blocks of the cells it is a corner of: its own
-  // block, and the one before along an axis where it starts a block.
-  vtkVolumeCutParallelFor(maximumThreads, blocks[2], [&](vtkIdType beginZ, vtkIdType endZ) {
-    for (vtkIdType bz = beginZ; bz < endZ; ++bz)
-    {
-      // The voxels of this layer's cells, far corners included.
-      const int k0 = static_cast<int>(bz) * size;
-      const int k1 = std::min(k0 + size, dims[2] - 1);
-      for (int by = 0; by < blocks[1]; ++by)
-      {
-        const int j0 = by * size;
-        const int j1 = std::min(j0 + size, dims[1] - 1);
-        for (int bx = 0; bx < blocks[0]; ++bx)
-        {
-          const int i0 = bx * size;
-          const int i1 = std::min(i0 + size, dims[0] - 1);
-          bool nonZero = false;
-          for (int k = k0; k <= k1 && !nonZero; ++k)
-          {
-            for (int j = j0; j <= j1 && !nonZero; ++j)
-            {
-              const float* row = fraction.Values.data() + j * sy + k * sz;
-              for (int i = i0; i <= i1; ++i)
-              {
-                // NaN counts, as interpolating it does.
-                if (!(row[i] == 0.f))
-                {
-                  nonZero = true;
-                  break;
-                }
-              }
-            }
-          }
-          fraction.NonZeroBlocks[bx + static_cast<size_t>(blocks[0]) * (by + static_cast<size_t>(blocks[1]) * bz)] = nonZero ? 1 : 0;
-        }
-      }
-    }
-  });
-}
-
-bool SameGeometry(vtkImageData* a, vtkImageData* b)
-{
-  int da[3];
-  int db[3];
-  a->GetDimensions(da);
-  b->GetDimensions(db);
-  return da[0] == db[0] && da[1] == db[1] && da[2] == db[2];
-}
-}
-
 //------------------------------------------------------------------------------
 bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
 {
@@ -638,45 +412,11 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   if (impl.AnatomyCopyTime < anatomy->GetMTime() || impl.AnatomyCopyTime < scalars->GetMTime() ||
     (impl.AnatomyMatrix && impl.AnatomyCopyTime < impl.AnatomyMatrix->GetMTime()))
   {
-    vtkNew<vtkMatrix4x4> ijkToWorld;
-    if (impl.AnatomyMatrix)
+    if (const char* error = vtkVolumeCutSceneInputs::CopyAnatomy(anatomy, scalars, impl.AnatomyMatrix, impl.Scene))
     {
-      ijkToWorld->DeepCopy(impl.AnatomyMatrix);
-    }
-    else
-    {
-      ijkToWorld->DeepCopy(anatomy->GetIndexToPhysicalMatrix());
-    }
-    if (!(std::abs(ijkToWorld->Determinant()) > 1e-12))
-    {
-      vtkErrorMacro("Render: the anatomy's IJK-to-world matrix is not invertible");
+      vtkErrorMacro(<< error);
       return false;
     }
-    vtkNew<vtkMatrix4x4> worldToIJK;
-    vtkMatrix4x4::Invert(ijkToWorld, worldToIJK);
-    std::copy(&ijkToWorld->Element[0][0], &ijkToWorld->Element[0][0] + 16, impl.Scene.IJKToWorld);
-    std::copy(&worldToIJK->Element[0][0], &worldToIJK->Element[0][0] + 16, impl.Scene.WorldToIJK);
-    // Normals: the transpose of world-to-IJK's linear part maps IJK gradients to world.
-    std::fill(impl.Scene.NormalMatrix, impl.Scene.NormalMatrix + 16, 0.0);
-    for (int row = 0; row < 3; ++row)
-    {
-      for (int column = 0; column < 3; ++column)
-      {
-        impl.Scene.NormalMatrix[4 * row + column] = worldToIJK->GetElement(column, row);
-      }
-    }
-    impl.Scene.NormalMatrix[15] = 1.0;
-    const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
-    impl.Scene.Values.resize(count);
-    const int stride = scalars->GetNumberOfComponents();
-    switch (scalars->GetDataType())
-    {
-      vtkTemplateMacro(CopyFirstComponent(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), stride, count, impl.Scene.Values.data()));
-      default:
-        vtkErrorMacro("Render: unsupported anatomy scalar type");
-        return false;
-    }
-    std::copy(dims, dims + 3, impl.Scene.Dimensions);
     impl.AnatomyCopyTime = std::max({ anatomy->GetMTime(), scalars->GetMTime(), impl.AnatomyMatrix ? impl.AnatomyMatrix->GetMTime() : 0 });
     impl.LabelCopyTime = 0;
     impl.BlockTime = 0;
@@ -702,26 +442,14 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     impl.LabelCopyTime < labelMap->GetPointData()->GetScalars()->GetMTime())
   {
     vtkDataArray* labelScalars = labelMap->GetPointData()->GetScalars();
-    if (!labelScalars || !SameGeometry(labelMap, anatomy))
+    if (!labelScalars || !vtkVolumeCutSceneInputs::SameDimensions(labelMap, anatomy))
     {
       vtkErrorMacro("Render: the label map must have the anatomy's dimensions; rendering without labels");
       impl.Scene.Labels.clear();
     }
-    else
+    else if (vtkVolumeCutSceneInputs::CopyLabels(labelScalars, impl.Scene.Labels))
     {
-      const vtkIdType count = labelScalars->GetNumberOfTuples();
-      impl.Scene.Labels.resize(count);
-      bool outOfRange = false;
-      for (vtkIdType n = 0; n < count; ++n)
-      {
-        const double label = labelScalars->GetComponent(n, 0);
-        outOfRange |= !(label >= 0.0 && label <= 65535.0);
-        impl.Scene.Labels[n] = static_cast<uint16_t>(std::min(65535.0, std::max(0.0, std::isfinite(label) ? label : 0.0)));
-      }
-      if (outOfRange)
-      {
-        vtkWarningMacro("Render: label values outside 0..65535 were clamped");
-      }
+      vtkWarningMacro("Render: label values outside 0..65535 were clamped");
     }
     impl.LabelCopyTime = std::max(labelMap->GetMTime(), labelScalars ? labelScalars->GetMTime() : 0);
     ++impl.LabelVersion;
@@ -746,21 +474,14 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     {
       vtkImageData* image = entry.second.Image;
       vtkDataArray* values = image->GetPointData()->GetScalars();
-      if (!values || !SameGeometry(image, anatomy))
+      if (!values || !vtkVolumeCutSceneInputs::SameDimensions(image, anatomy))
       {
         vtkErrorMacro("Render: the fractional labelmap of segment " << entry.first << " must have the anatomy's dimensions; it is not shown");
         continue;
       }
       vtkVolumeCutRayScene::FractionVolume fraction;
       fraction.Label = entry.first;
-      fraction.Values.resize(values->GetNumberOfTuples());
-      const double v0 = entry.second.ValueAtZero;
-      const double scale = 1.0 / (entry.second.ValueAtOne - entry.second.ValueAtZero);
-      for (vtkIdType n = 0; n < values->GetNumberOfTuples(); ++n)
-      {
-        const double f = (values->GetComponent(n, 0) - v0) * scale;
-        fraction.Values[n] = std::isfinite(f) ? static_cast<float>(std::min(1.0, std::max(0.0, f))) : 0.f;
-      }
+      vtkVolumeCutSceneInputs::CopyFraction(values, entry.second.ValueAtZero, entry.second.ValueAtOne, fraction.Values);
       impl.Scene.Fractions.push_back(std::move(fraction));
     }
     impl.GivenFractions = impl.Scene.Fractions.size();
@@ -827,7 +548,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   {
     if (fraction.NonZeroBlocks.size() != static_cast<size_t>(fractionBlocks[0]) * fractionBlocks[1] * fractionBlocks[2])
     {
-      MarkNonZeroBlocks(impl.Scene, fraction, this->MaximumNumberOfThreads);
+      vtkVolumeCutSceneInputs::MarkNonZeroBlocks(impl.Scene, fraction, this->MaximumNumberOfThreads);
     }
   }
 
@@ -839,16 +560,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       vtkErrorMacro("Render: the composite mode needs colour and opacity transfer functions");
       return false;
     }
-    double range[2];
-    impl.OpacityFunction->GetRange(range);
-    double colorRange[2];
-    impl.ColorFunction->GetRange(colorRange);
-    impl.Scene.TableRange[0] = std::min(range[0], colorRange[0]);
-    impl.Scene.TableRange[1] = std::max(range[1], colorRange[1]);
-    impl.Scene.ColorTable.resize(3 * TransferTableSize);
-    impl.Scene.OpacityTable.resize(TransferTableSize);
-    impl.ColorFunction->GetTable(impl.Scene.TableRange[0], impl.Scene.TableRange[1], TransferTableSize, impl.Scene.ColorTable.data());
-    impl.OpacityFunction->GetTable(impl.Scene.TableRange[0], impl.Scene.TableRange[1], TransferTableSize, impl.Scene.OpacityTable.data());
+    vtkVolumeCutSceneInputs::CopyTransferFunctions(impl.ColorFunction, impl.OpacityFunction, impl.Scene);
   }
 
   impl.Scene.AnyIsoSegment = false;
@@ -910,45 +622,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   {
     CutEntry& entry = impl.Cuts[n];
     vtkVolumeCutField* field = entry.Field;
-    const int factor = field->GetSubVoxelFactor();
-    bool usable = factor > 0;
-    if (usable)
-    {
-      const int* fieldDims = field->GetDimensions();
-      usable = fieldDims[0] == dims[0] * factor && fieldDims[1] == dims[1] * factor && fieldDims[2] == dims[2] * factor;
-    }
-    if (usable)
-    {
-      vtkNew<vtkMatrix4x4> subToWorld;
-      field->GetSubVoxelIJKToRAS(subToWorld);
-      // Sub-voxel s lies at anatomy index (s + 0.5) / f - 0.5.
-      double tolerance = 0.0;
-      for (int axis = 0; axis < 3; ++axis)
-      {
-        double column[3];
-        const double unit[3] = { axis == 0 ? 1.0 : 0.0, axis == 1 ? 1.0 : 0.0, axis == 2 ? 1.0 : 0.0 };
-        TransformVector(impl.Scene.IJKToWorld, unit, column);
-        tolerance = std::max(tolerance, 1e-4 * vtkMath::Norm(column));
-      }
-      for (int corner = 0; corner < 4 && usable; ++corner)
-      {
-        const double sub[3] = { corner == 1 ? 10.0 : 0.0, corner == 2 ? 10.0 : 0.0, corner == 3 ? 10.0 : 0.0 };
-        double h[4] = { sub[0], sub[1], sub[2], 1.0 };
-        double viaField[4];
-        subToWorld->MultiplyPoint(h, viaField);
-        double anatomyIndex[3];
-        for (int axis = 0; axis < 3; ++axis)
-        {
-          anatomyIndex[axis] = (sub[axis] + 0.5) / factor - 0.5;
-        }
-        double viaAnatomy[3];
-        TransformPoint(impl.Scene.IJKToWorld, anatomyIndex, viaAnatomy);
-        for (int axis = 0; axis < 3; ++axis)
-        {
-          usable &= std::abs(viaField[axis] - viaAnatomy[axis]) <= tolerance;
-        }
-      }
-    }
+    const bool usable = vtkVolumeCutSceneInputs::OnAnatomyGrid(field, dims, impl.Scene.IJKToWorld);
     if (!usable && !entry.Reported)
     {
       vtkErrorMacro("Render: cut field " << n << " was not made on the anatomy's voxel grid; it is not shown");
@@ -966,24 +640,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     }
   }
 
-  impl.Scene.Planes.clear();
-  if (impl.Planes)
-  {
-    impl.Planes->InitTraversal();
-    while (vtkPlane* plane = impl.Planes->GetNextItem())
-    {
-      vtkVolumeCutRayScene::PlaneEquation equation;
-      plane->GetNormal(equation.Normal);
-      if (vtkMath::Normalize(equation.Normal) <= 0.0)
-      {
-        continue;
-      }
-      double origin[3];
-      plane->GetOrigin(origin);
-      equation.Offset = -vtkMath::Dot(equation.Normal, origin);
-      impl.Scene.Planes.push_back(equation);
-    }
-  }
+  vtkVolumeCutSceneInputs::CopyPlanes(impl.Planes, impl.Scene.Planes);
 
   if (sceneChanged)
   {
