@@ -158,11 +158,11 @@ class VolumeCutThreeDView(ThreeDView):
             view_node.SetBoxVisible(False)
             view_node.SetAxisLabelsVisible(False)
 
-    def look_from(self, bounds, direction, view_up=(0.0, 0.0, 1.0), margin=0.05) -> None:
+    def look_from(self, bounds, direction, view_up=(0.0, 0.0, 1.0), margin=0.12) -> None:
         """Look at the centre of ``bounds`` (RAS) from ``direction`` (towards the eye), the whole box in view.
 
         The distance is the nearest at which every corner of the box projects inside the view, less
-        ``margin`` of its half-size on each side, at this view's aspect: a scan whose tissue fills its
+        ``margin`` of its half-size on each side (room for the mode hint along the bottom), at this view's aspect: a scan whose tissue fills its
         box (a temporal-bone block) opens whole, not as a close-up of its near face.
         """
         width, height = self.render_window().GetSize() if self.render_window() is not None else (1, 1)
