@@ -50,8 +50,11 @@ def check_outputs(summary, out_dir):
     reloaded.load_bundle(out_dir / "scene.mrb")
     cut = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
     assert cut is not None
-    assert list(cut.GetCuttableSegmentIDs()) == summary["cuttable_segments"]
-    assert list(cut.GetProtectedSegmentIDs()) == summary["protected_segments"]
+    assert list(cut.GetCuttableSegmentIDs()) == summary["cuttable_segment_ids"]
+    assert list(cut.GetProtectedSegmentIDs()) == summary["protected_segment_ids"]
+    segments = cut.GetSegmentationNode().GetSegmentation()
+    assert summary["cuttable_segments"] == [segments.GetSegment(s).GetName() for s in summary["cuttable_segment_ids"]]
+    assert summary["protected_segments"] == [segments.GetSegment(s).GetName() for s in summary["protected_segment_ids"]]
     assert cut.GetAnatomyVolumeNode() is not None
     assert cut.GetSegmentationNode() is not None
     # The drilling itself came back: the same removed volume, kept by the logic.
@@ -61,10 +64,20 @@ def check_outputs(summary, out_dir):
     assert logic.GetRemovedVolume(cut) == pytest.approx(summary["drilling"]["removed_volume_mm3"], abs=0.006)
     # Kept, or copied exactly where Slicer's reader reindexed a left-handed scan.
     assert logic.GetCutField(cut) is field or logic.GetCutField(cut).IsSameLattice(field)
-    for segment_id, volume in summary["drilling"]["removed_volume_per_segment_mm3"].items():
-        assert logic.GetRemovedVolumeInSegment(cut, segment_id) == pytest.approx(volume, abs=0.006)
-    for segment_id in summary["protected_segments"]:
+    # Figures per segment are keyed by the segment's name, its ID beside.
+    per_segment = summary["drilling"]["removed_volume_per_segment"]
+    assert len(per_segment) == segments.GetNumberOfSegments()
+    for name, entry in per_segment.items():
+        assert segments.GetSegment(entry["segment_id"]).GetName() == name
+        assert logic.GetRemovedVolumeInSegment(cut, entry["segment_id"]) == pytest.approx(entry["removed_volume_mm3"], abs=0.006)
+    for name, entry in summary["drilling"]["removed_volume_table"].items():
+        assert per_segment[name]["segment_id"] == entry["segment_id"]
+    for segment_id in summary["protected_segment_ids"]:
         assert logic.GetRemovedVolumeInSegment(cut, segment_id) == 0.0
+    for name, entry in summary["drilling"]["contacts_per_segment"].items():
+        assert segments.GetSegment(entry["segment_id"]).GetName() == name and entry["contact_events"] > 0
+    assert sum(e["contact_events"] for e in summary["drilling"]["contacts_per_segment"].values()) == \
+        summary["drilling"]["contact_events"]
     assert json.loads((out_dir / "summary.json").read_text()) == summary
     assert (out_dir / "removed.stl").stat().st_size > 1000
     assert reloaded.scene.GetFirstNodeByName(summary["exports"]["drilled_ct"]) is not None
@@ -81,9 +94,10 @@ def test_main_job_on_the_phantom(tmp_path):
 @pytest.mark.realdata
 def test_main_job_on_the_real_head_ct(tmp_path):
     summary = mainjob.run(False, tmp_path, size=(320, 240))
-    assert summary["bone_segments"] == ["CorticalBone", "TrabecularBone"]
-    removed = summary["drilling"]["removed_volume_per_segment_mm3"]
-    assert removed["CorticalBone"] > 100.0  # the mastoid cortex is opened
+    assert summary["bone_segments"] == ["Cortical bone", "Trabecular bone"]
+    assert summary["bone_segment_ids"] == ["CorticalBone", "TrabecularBone"]
+    removed = summary["drilling"]["removed_volume_per_segment"]
+    assert removed["Cortical bone"]["removed_volume_mm3"] > 100.0  # the mastoid cortex is opened
     check_outputs(summary, tmp_path)
 
 

@@ -34,6 +34,7 @@ from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
 from ..scene.application import HeadlessSlicer
+from ..scene.nodes import by_segment_name, segment_display_names
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
 # the structures whose injury is the complication the trainee must avoid.
@@ -126,6 +127,18 @@ def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool, own_data
         protected = []
     cut_node.SetProtectedSegmentIDs(protected)
     cut_node.SetCuttableSegmentIDs(cuttable)
+
+
+def contacts_by_segment(contact_table) -> dict:
+    """Per segment ID of the contact table: its contact events and the deepest one (mm)."""
+    contacts = {}
+    for row in range(contact_table.GetNumberOfRows()):
+        segment_id = contact_table.GetCellText(row, 0)
+        depth = float(contact_table.GetCellText(row, 3))
+        entry = contacts.setdefault(segment_id, {"contact_events": 0, "deepest_mm": 0.0})
+        entry["contact_events"] += 1
+        entry["deepest_mm"] = round(max(entry["deepest_mm"], depth), 3)
+    return contacts
 
 
 def cavity_camera(view, plan):
@@ -227,16 +240,20 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     drilled["tool_presets"] = {key: tool.GetName() for key, tool in tools.items()}
     contact_table = logic.GetContactTableNode(cut_node)
     drilled["contact_events"] = contact_table.GetNumberOfRows()
-    drilled["removed_volume_table"] = {
-        volume_table.GetCellText(row, 0): float(volume_table.GetCellText(row, 3)) for row in range(volume_table.GetNumberOfRows())}
+    roles = roles_segmentation.GetSegmentation()
+    drilled["contacts_per_segment"] = by_segment_name(roles, contacts_by_segment(contact_table))
+    drilled["removed_volume_table"] = by_segment_name(roles, {
+        volume_table.GetCellText(row, 0): {"role": volume_table.GetCellText(row, 2),
+                                           "removed_volume_mm3": float(volume_table.GetCellText(row, 3))}
+        for row in range(volume_table.GetNumberOfRows())})
     # Then a session through the haptic path, beside the cavity: what it cuts
     # adds to the recorded mastoidectomy's volume in the tables that follow.
     with timer.measure("haptics_s"):
         haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
-    removed_per_segment = {
-        segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
-        for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
-    }
+    removed_per_segment = by_segment_name(roles, {
+        segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
+        for segment_id in roles.GetSegmentIDs()
+    })
     # Exports: the removed region as a segment (binary labelmap) and as a
     # fraction volume on the CT's grid, as a closed surface (STL), and the
     # drilled CT.
@@ -314,14 +331,23 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
             "removed_volume_mm3": round(reloaded.volume_cutting_logic.GetRemovedVolume(read), 2),
         }
 
-    segmentation = bone.GetSegmentation()
+    # Segments by the names a person gave them; their IDs beside, for scripts that look them up.
+    bone_ids = list(bone.GetSegmentation().GetSegmentIDs())
+    bone_names = segment_display_names(bone.GetSegmentation(), bone_ids)
+    role_names = segment_display_names(roles, roles.GetSegmentIDs())
+    cuttable_ids = list(cut_node.GetCuttableSegmentIDs())
+    protected_ids = list(cut_node.GetProtectedSegmentIDs())
+    contact_id = logic.GetContactSegmentID(cut_node)
     summary = {
         "anatomy": description,
         "ct_node": volume.GetName(),
-        "bone_segments": list(segmentation.GetSegmentIDs()),
+        "bone_segments": [bone_names[s] for s in bone_ids],
+        "bone_segment_ids": bone_ids,
         "volume_cut_node": cut_node.GetName(),
-        "cuttable_segments": list(cut_node.GetCuttableSegmentIDs()),
-        "protected_segments": list(cut_node.GetProtectedSegmentIDs()),
+        "cuttable_segments": [role_names[s] for s in cuttable_ids],
+        "cuttable_segment_ids": cuttable_ids,
+        "protected_segments": [role_names[s] for s in protected_ids],
+        "protected_segment_ids": protected_ids,
         "sub_voxel_factor": cut_node.GetSubVoxelFactor(),
         "inputs_ok": bool(inputs_ok),
         "input_messages": messages.GetAllMessagesAsString(),
@@ -334,9 +360,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
             },
             **drilled,
             "removed_volume_mm3": round(logic.GetRemovedVolume(cut_node), 2),
-            "removed_volume_per_segment_mm3": removed_per_segment,
+            "removed_volume_per_segment": removed_per_segment,
             "deepest_contact_with_protected": {
-                "segment": logic.GetContactSegmentID(cut_node),
+                "segment": role_names.get(contact_id, contact_id),
+                "segment_id": contact_id,
                 "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
             },
         },
@@ -361,12 +388,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     # Soft-tissue resection planning (SoftCut) on the head CT, in its own scene.
     summary["softcut"] = softcutjob.run(out_dir, size=size, head_ct=not use_phantom and own_data is None)
     if own_data is not None:
-        segmentation_of_roles = roles_segmentation.GetSegmentation()
         summary["own_data"] = {
             "ct": str(own_data.ct),
             "segmentation": str(own_data.segmentation) if own_data.segmentation is not None else None,
-            "segment_names": {segment_id: segmentation_of_roles.GetSegment(segment_id).GetName()
-                              for segment_id in segmentation_of_roles.GetSegmentIDs()},
+            "segment_names": {segment_id: roles.GetSegment(segment_id).GetName() for segment_id in roles.GetSegmentIDs()},
             "warnings": list(own_data.warnings),
         }
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
