@@ -31,6 +31,11 @@ def foreground_fraction(pixels):
     return float((np.abs(pixels - background).sum(axis=2) > 30).mean())
 
 
+def cut_overlay(pixels):
+    """Pixels of the slice view where the cut's red outline or fill lies over the grey CT."""
+    return (pixels[..., 0] - np.maximum(pixels[..., 1], pixels[..., 2])) > 60
+
+
 def check_outputs(summary, out_dir):
     assert summary["inputs_ok"], summary["input_messages"]
     pixels = read_png(out_dir / "3d.png")
@@ -78,6 +83,12 @@ def check_outputs(summary, out_dir):
         assert segments.GetSegment(entry["segment_id"]).GetName() == name and entry["contact_events"] > 0
     assert sum(e["contact_events"] for e in summary["drilling"]["contacts_per_segment"].values()) == \
         summary["drilling"]["contact_events"]
+    # The axial slice is centred on the cut and shows it with bone around it.
+    overlay = cut_overlay(read_png(out_dir / "cut_slice_axial.png"))
+    assert 0.01 < overlay.mean() < 0.4
+    rows, columns = np.nonzero(overlay)
+    assert abs(rows.mean() / overlay.shape[0] - 0.5) < 0.1
+    assert abs(columns.mean() / overlay.shape[1] - 0.5) < 0.1
     assert json.loads((out_dir / "summary.json").read_text()) == summary
     assert (out_dir / "removed.stl").stat().st_size > 1000
     assert reloaded.scene.GetFirstNodeByName(summary["exports"]["drilled_ct"]) is not None

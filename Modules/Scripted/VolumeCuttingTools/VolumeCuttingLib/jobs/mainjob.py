@@ -34,7 +34,7 @@ from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
 from ..scene.application import HeadlessSlicer
-from ..scene.nodes import by_segment_name, segment_display_names
+from ..scene.nodes import array_from_volume_node, by_segment_name, segment_display_names, volume_node_ijk_to_ras
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
 # the structures whose injury is the complication the trainee must avoid.
@@ -139,6 +139,36 @@ def contacts_by_segment(contact_table) -> dict:
         entry["contact_events"] += 1
         entry["deepest_mm"] = round(max(entry["deepest_mm"], depth), 3)
     return contacts
+
+
+# The slice view shows the removed region at the middle half of its width,
+# and at least this much (mm) around a small one.
+SLICE_VIEW_MINIMUM_FIELD_MM = 30.0
+
+
+def removed_region_view(removed_fraction_node):
+    """Where an axial view of the cut looks (RAS, mm) and its field of view (mm).
+
+    In the axial plane through the removed region's centroid (weighted by
+    each voxel's removed fraction), centred on the region's box in that plane,
+    which fills the middle half of the view: the cavity with the bone around it.
+    """
+    fraction = array_from_volume_node(removed_fraction_node)
+    removed = np.argwhere(fraction > 0.0)
+    if len(removed) == 0:
+        raise RuntimeError("the cut removed nothing: there is no cavity to show in the slice view")
+    ijk_to_ras = volume_node_ijk_to_ras(removed_fraction_node)
+    ras = removed[:, ::-1] @ ijk_to_ras[:3, :3].T + ijk_to_ras[:3, 3]
+    weights = fraction[tuple(removed.T)].astype(float)
+    centroid = weights @ ras / weights.sum()
+    # The box of the voxels that are mostly removed, near the centroid's axial plane.
+    slab = np.abs(ras[:, 2] - centroid[2]) <= max(1.0, float(np.ptp(ras[:, 2])) / 4.0)
+    mostly = slab & (weights >= 0.5)
+    inside = ras[mostly] if mostly.any() else ras
+    low, high = inside[:, :2].min(axis=0), inside[:, :2].max(axis=0)
+    center = np.array([(low[0] + high[0]) / 2.0, (low[1] + high[1]) / 2.0, centroid[2]])
+    field = max(SLICE_VIEW_MINIMUM_FIELD_MM, 2.0 * float(np.max(high - low)))
+    return center, field
 
 
 def cavity_camera(view, plan):
@@ -308,14 +338,14 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
 
     # A slice view across the cavity: the cut's outline and fill over the CT
     # show how deep it goes (seed 000, Fig. 5d).
-    cavity = entry + 0.5 * plan.depth * np.asarray(plan.direction, dtype=float) / np.linalg.norm(plan.direction)
+    slice_center, field_of_view = removed_region_view(removed_fraction)
     slice_view = application.create_slice_view("Axial", 600, 600, "Red")
     slice_view.set_background_volume(volume)
     # Slicer's axial orientation: the patient's right on the view's left.
     slice_to_ras = np.diag([-1.0, 1.0, 1.0, 1.0])
-    slice_to_ras[:3, 3] = cavity
+    slice_to_ras[:3, 3] = slice_center
     slice_view.set_slice_to_ras(slice_to_ras)
-    slice_view.slice_node.SetFieldOfView(70.0, 70.0, 1.0)
+    slice_view.slice_node.SetFieldOfView(field_of_view, field_of_view, 1.0)
     slice_path = slice_view.screenshot(out_dir / "cut_slice_axial.png")
     slice_view.close()
 
