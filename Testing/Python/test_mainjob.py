@@ -83,9 +83,10 @@ def check_outputs(summary, out_dir):
         assert segments.GetSegment(entry["segment_id"]).GetName() == name and entry["contact_events"] > 0
     assert sum(e["contact_events"] for e in summary["drilling"]["contacts_per_segment"].values()) == \
         summary["drilling"]["contact_events"]
-    # The axial slice is centred on the cut and shows it with bone around it.
+    # The axial slice is centred on the cut and shows it large enough to read
+    # its depth, with bone around it (a fixed 70 mm field left it at 3-5 %).
     overlay = cut_overlay(read_png(out_dir / "cut_slice_axial.png"))
-    assert 0.01 < overlay.mean() < 0.4
+    assert 0.06 < overlay.mean() < 0.4
     rows, columns = np.nonzero(overlay)
     assert abs(rows.mean() / overlay.shape[0] - 0.5) < 0.1
     assert abs(columns.mean() / overlay.shape[1] - 0.5) < 0.1

@@ -141,7 +141,7 @@ def contacts_by_segment(contact_table) -> dict:
     return contacts
 
 
-# The slice view shows the removed region at the middle half of its width,
+# The slice view shows the removed region across the middle 40 % of its width,
 # and at least this much (mm) around a small one.
 SLICE_VIEW_MINIMUM_FIELD_MM = 30.0
 
@@ -151,7 +151,7 @@ def removed_region_view(removed_fraction_node):
 
     In the axial plane through the removed region's centroid (weighted by
     each voxel's removed fraction), centred on the region's box in that plane,
-    which fills the middle half of the view: the cavity with the bone around it.
+    which spans the middle 40 % of the view: the cavity with the bone around it.
     """
     fraction = array_from_volume_node(removed_fraction_node)
     removed = np.argwhere(fraction > 0.0)
@@ -167,7 +167,7 @@ def removed_region_view(removed_fraction_node):
     inside = ras[mostly] if mostly.any() else ras
     low, high = inside[:, :2].min(axis=0), inside[:, :2].max(axis=0)
     center = np.array([(low[0] + high[0]) / 2.0, (low[1] + high[1]) / 2.0, centroid[2]])
-    field = max(SLICE_VIEW_MINIMUM_FIELD_MM, 2.0 * float(np.max(high - low)))
+    field = max(SLICE_VIEW_MINIMUM_FIELD_MM, 2.5 * float(np.max(high - low)))
     return center, field
 
 
