@@ -31,6 +31,11 @@ def foreground_fraction(pixels):
     return float((np.abs(pixels - background).sum(axis=2) > 30).mean())
 
 
+def cut_overlay(pixels):
+    """Pixels of the slice view where the cut's red outline or fill lies over the grey CT."""
+    return (pixels[..., 0] - np.maximum(pixels[..., 1], pixels[..., 2])) > 60
+
+
 def check_outputs(summary, out_dir):
     assert summary["inputs_ok"], summary["input_messages"]
     pixels = read_png(out_dir / "3d.png")
@@ -50,8 +55,11 @@ def check_outputs(summary, out_dir):
     reloaded.load_bundle(out_dir / "scene.mrb")
     cut = reloaded.scene.GetFirstNodeByClass("vtkMRMLVolumeCutNode")
     assert cut is not None
-    assert list(cut.GetCuttableSegmentIDs()) == summary["cuttable_segments"]
-    assert list(cut.GetProtectedSegmentIDs()) == summary["protected_segments"]
+    assert list(cut.GetCuttableSegmentIDs()) == summary["cuttable_segment_ids"]
+    assert list(cut.GetProtectedSegmentIDs()) == summary["protected_segment_ids"]
+    segments = cut.GetSegmentationNode().GetSegmentation()
+    assert summary["cuttable_segments"] == [segments.GetSegment(s).GetName() for s in summary["cuttable_segment_ids"]]
+    assert summary["protected_segments"] == [segments.GetSegment(s).GetName() for s in summary["protected_segment_ids"]]
     assert cut.GetAnatomyVolumeNode() is not None
     assert cut.GetSegmentationNode() is not None
     # The drilling itself came back: the same removed volume, kept by the logic.
@@ -61,10 +69,27 @@ def check_outputs(summary, out_dir):
     assert logic.GetRemovedVolume(cut) == pytest.approx(summary["drilling"]["removed_volume_mm3"], abs=0.006)
     # Kept, or copied exactly where Slicer's reader reindexed a left-handed scan.
     assert logic.GetCutField(cut) is field or logic.GetCutField(cut).IsSameLattice(field)
-    for segment_id, volume in summary["drilling"]["removed_volume_per_segment_mm3"].items():
-        assert logic.GetRemovedVolumeInSegment(cut, segment_id) == pytest.approx(volume, abs=0.006)
-    for segment_id in summary["protected_segments"]:
+    # Figures per segment are keyed by the segment's name, its ID beside.
+    per_segment = summary["drilling"]["removed_volume_per_segment"]
+    assert len(per_segment) == segments.GetNumberOfSegments()
+    for name, entry in per_segment.items():
+        assert segments.GetSegment(entry["segment_id"]).GetName() == name
+        assert logic.GetRemovedVolumeInSegment(cut, entry["segment_id"]) == pytest.approx(entry["removed_volume_mm3"], abs=0.006)
+    for name, entry in summary["drilling"]["removed_volume_table"].items():
+        assert per_segment[name]["segment_id"] == entry["segment_id"]
+    for segment_id in summary["protected_segment_ids"]:
         assert logic.GetRemovedVolumeInSegment(cut, segment_id) == 0.0
+    for name, entry in summary["drilling"]["contacts_per_segment"].items():
+        assert segments.GetSegment(entry["segment_id"]).GetName() == name and entry["contact_events"] > 0
+    assert sum(e["contact_events"] for e in summary["drilling"]["contacts_per_segment"].values()) == \
+        summary["drilling"]["contact_events"]
+    # The axial slice is centred on the cut and shows it large enough to read
+    # its depth, with bone around it (a fixed 70 mm field left it at 3-5 %).
+    overlay = cut_overlay(read_png(out_dir / "cut_slice_axial.png"))
+    assert 0.06 < overlay.mean() < 0.4
+    rows, columns = np.nonzero(overlay)
+    assert abs(rows.mean() / overlay.shape[0] - 0.5) < 0.1
+    assert abs(columns.mean() / overlay.shape[1] - 0.5) < 0.1
     assert json.loads((out_dir / "summary.json").read_text()) == summary
     assert (out_dir / "removed.stl").stat().st_size > 1000
     assert reloaded.scene.GetFirstNodeByName(summary["exports"]["drilled_ct"]) is not None
@@ -81,9 +106,10 @@ def test_main_job_on_the_phantom(tmp_path):
 @pytest.mark.realdata
 def test_main_job_on_the_real_head_ct(tmp_path):
     summary = mainjob.run(False, tmp_path, size=(320, 240))
-    assert summary["bone_segments"] == ["CorticalBone", "TrabecularBone"]
-    removed = summary["drilling"]["removed_volume_per_segment_mm3"]
-    assert removed["CorticalBone"] > 100.0  # the mastoid cortex is opened
+    assert summary["bone_segments"] == ["Cortical bone", "Trabecular bone"]
+    assert summary["bone_segment_ids"] == ["CorticalBone", "TrabecularBone"]
+    removed = summary["drilling"]["removed_volume_per_segment"]
+    assert removed["Cortical bone"]["removed_volume_mm3"] > 100.0  # the mastoid cortex is opened
     check_outputs(summary, tmp_path)
 
 

@@ -542,8 +542,11 @@ def test_main_job_on_an_own_ct(tmp_path):
     assert result.returncode == 0, result.stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["own_data"]["ct"].endswith("head.nrrd")
-    assert summary["cuttable_segments"] == ["CorticalBone", "TrabecularBone"]
-    assert summary["drilling"]["removed_volume_per_segment_mm3"]["CorticalBone"] > 50.0
+    # Segments by the names a person reads, their IDs beside.
+    assert summary["cuttable_segments"] == ["Cortical bone", "Trabecular bone"]
+    assert summary["cuttable_segment_ids"] == ["CorticalBone", "TrabecularBone"]
+    cortical = summary["drilling"]["removed_volume_per_segment"]["Cortical bone"]
+    assert cortical["segment_id"] == "CorticalBone" and cortical["removed_volume_mm3"] > 50.0
     assert summary["drilling"]["refused_poses"] == 0
     for name in ("3d.png", "scene.mrb", "removed.stl"):
         assert (out / name).is_file()

@@ -52,6 +52,8 @@ def test_cheek_resection_on_the_head_ct(tmp_path):
     carve = summary["carve"]
     assert carve["undo_steps"] == 1 and carve["undo_then_redo_restores"]
     assert carve["removed_volume_mm3"] > volume  # the tissue, and the air just above the skin
+    soft_tissue = carve["removed_volume_per_segment"]["Soft tissue"]  # by name, its ID beside
+    assert soft_tissue["segment_id"] == "SoftTissue" and soft_tissue["removed_volume_mm3"] > 0.0
     with open(tmp_path / "softcut_measurements.csv") as stream:
         rows = {row["Measurement"]: float(row["Value"]) for row in csv.DictReader(stream)}
     assert rows["Resected volume"] == pytest.approx(volume, rel=1e-3)

@@ -34,6 +34,7 @@ from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
 from ..scene.application import HeadlessSlicer
+from ..scene.nodes import array_from_volume_node, by_segment_name, segment_display_names, volume_node_ijk_to_ras
 
 # Roles of the phantom's segments: what a mastoidectomy drill may remove, and
 # the structures whose injury is the complication the trainee must avoid.
@@ -126,6 +127,48 @@ def assign_roles(cut_node, segmentation_node, logic, use_phantom: bool, own_data
         protected = []
     cut_node.SetProtectedSegmentIDs(protected)
     cut_node.SetCuttableSegmentIDs(cuttable)
+
+
+def contacts_by_segment(contact_table) -> dict:
+    """Per segment ID of the contact table: its contact events and the deepest one (mm)."""
+    contacts = {}
+    for row in range(contact_table.GetNumberOfRows()):
+        segment_id = contact_table.GetCellText(row, 0)
+        depth = float(contact_table.GetCellText(row, 3))
+        entry = contacts.setdefault(segment_id, {"contact_events": 0, "deepest_mm": 0.0})
+        entry["contact_events"] += 1
+        entry["deepest_mm"] = round(max(entry["deepest_mm"], depth), 3)
+    return contacts
+
+
+# The slice view shows the removed region across the middle 40 % of its width,
+# and at least this much (mm) around a small one.
+SLICE_VIEW_MINIMUM_FIELD_MM = 30.0
+
+
+def removed_region_view(removed_fraction_node):
+    """Where an axial view of the cut looks (RAS, mm) and its field of view (mm).
+
+    In the axial plane through the removed region's centroid (weighted by
+    each voxel's removed fraction), centred on the region's box in that plane,
+    which spans the middle 40 % of the view: the cavity with the bone around it.
+    """
+    fraction = array_from_volume_node(removed_fraction_node)
+    removed = np.argwhere(fraction > 0.0)
+    if len(removed) == 0:
+        raise RuntimeError("the cut removed nothing: there is no cavity to show in the slice view")
+    ijk_to_ras = volume_node_ijk_to_ras(removed_fraction_node)
+    ras = removed[:, ::-1] @ ijk_to_ras[:3, :3].T + ijk_to_ras[:3, 3]
+    weights = fraction[tuple(removed.T)].astype(float)
+    centroid = weights @ ras / weights.sum()
+    # The box of the voxels that are mostly removed, near the centroid's axial plane.
+    slab = np.abs(ras[:, 2] - centroid[2]) <= max(1.0, float(np.ptp(ras[:, 2])) / 4.0)
+    mostly = slab & (weights >= 0.5)
+    inside = ras[mostly] if mostly.any() else ras
+    low, high = inside[:, :2].min(axis=0), inside[:, :2].max(axis=0)
+    center = np.array([(low[0] + high[0]) / 2.0, (low[1] + high[1]) / 2.0, centroid[2]])
+    field = max(SLICE_VIEW_MINIMUM_FIELD_MM, 2.5 * float(np.max(high - low)))
+    return center, field
 
 
 def cavity_camera(view, plan):
@@ -227,16 +270,20 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     drilled["tool_presets"] = {key: tool.GetName() for key, tool in tools.items()}
     contact_table = logic.GetContactTableNode(cut_node)
     drilled["contact_events"] = contact_table.GetNumberOfRows()
-    drilled["removed_volume_table"] = {
-        volume_table.GetCellText(row, 0): float(volume_table.GetCellText(row, 3)) for row in range(volume_table.GetNumberOfRows())}
+    roles = roles_segmentation.GetSegmentation()
+    drilled["contacts_per_segment"] = by_segment_name(roles, contacts_by_segment(contact_table))
+    drilled["removed_volume_table"] = by_segment_name(roles, {
+        volume_table.GetCellText(row, 0): {"role": volume_table.GetCellText(row, 2),
+                                           "removed_volume_mm3": float(volume_table.GetCellText(row, 3))}
+        for row in range(volume_table.GetNumberOfRows())})
     # Then a session through the haptic path, beside the cavity: what it cuts
     # adds to the recorded mastoidectomy's volume in the tables that follow.
     with timer.measure("haptics_s"):
         haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
-    removed_per_segment = {
-        segment_id: round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)
-        for segment_id in roles_segmentation.GetSegmentation().GetSegmentIDs()
-    }
+    removed_per_segment = by_segment_name(roles, {
+        segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
+        for segment_id in roles.GetSegmentIDs()
+    })
     # Exports: the removed region as a segment (binary labelmap) and as a
     # fraction volume on the CT's grid, as a closed surface (STL), and the
     # drilled CT.
@@ -291,14 +338,14 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
 
     # A slice view across the cavity: the cut's outline and fill over the CT
     # show how deep it goes (seed 000, Fig. 5d).
-    cavity = entry + 0.5 * plan.depth * np.asarray(plan.direction, dtype=float) / np.linalg.norm(plan.direction)
+    slice_center, field_of_view = removed_region_view(removed_fraction)
     slice_view = application.create_slice_view("Axial", 600, 600, "Red")
     slice_view.set_background_volume(volume)
     # Slicer's axial orientation: the patient's right on the view's left.
     slice_to_ras = np.diag([-1.0, 1.0, 1.0, 1.0])
-    slice_to_ras[:3, 3] = cavity
+    slice_to_ras[:3, 3] = slice_center
     slice_view.set_slice_to_ras(slice_to_ras)
-    slice_view.slice_node.SetFieldOfView(70.0, 70.0, 1.0)
+    slice_view.slice_node.SetFieldOfView(field_of_view, field_of_view, 1.0)
     slice_path = slice_view.screenshot(out_dir / "cut_slice_axial.png")
     slice_view.close()
 
@@ -314,14 +361,23 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
             "removed_volume_mm3": round(reloaded.volume_cutting_logic.GetRemovedVolume(read), 2),
         }
 
-    segmentation = bone.GetSegmentation()
+    # Segments by the names a person gave them; their IDs beside, for scripts that look them up.
+    bone_ids = list(bone.GetSegmentation().GetSegmentIDs())
+    bone_names = segment_display_names(bone.GetSegmentation(), bone_ids)
+    role_names = segment_display_names(roles, roles.GetSegmentIDs())
+    cuttable_ids = list(cut_node.GetCuttableSegmentIDs())
+    protected_ids = list(cut_node.GetProtectedSegmentIDs())
+    contact_id = logic.GetContactSegmentID(cut_node)
     summary = {
         "anatomy": description,
         "ct_node": volume.GetName(),
-        "bone_segments": list(segmentation.GetSegmentIDs()),
+        "bone_segments": [bone_names[s] for s in bone_ids],
+        "bone_segment_ids": bone_ids,
         "volume_cut_node": cut_node.GetName(),
-        "cuttable_segments": list(cut_node.GetCuttableSegmentIDs()),
-        "protected_segments": list(cut_node.GetProtectedSegmentIDs()),
+        "cuttable_segments": [role_names[s] for s in cuttable_ids],
+        "cuttable_segment_ids": cuttable_ids,
+        "protected_segments": [role_names[s] for s in protected_ids],
+        "protected_segment_ids": protected_ids,
         "sub_voxel_factor": cut_node.GetSubVoxelFactor(),
         "inputs_ok": bool(inputs_ok),
         "input_messages": messages.GetAllMessagesAsString(),
@@ -334,9 +390,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
             },
             **drilled,
             "removed_volume_mm3": round(logic.GetRemovedVolume(cut_node), 2),
-            "removed_volume_per_segment_mm3": removed_per_segment,
+            "removed_volume_per_segment": removed_per_segment,
             "deepest_contact_with_protected": {
-                "segment": logic.GetContactSegmentID(cut_node),
+                "segment": role_names.get(contact_id, contact_id),
+                "segment_id": contact_id,
                 "depth_mm": round(logic.GetCutField(cut_node).GetMaximumContactDepth(), 3),
             },
         },
@@ -361,12 +418,10 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     # Soft-tissue resection planning (SoftCut) on the head CT, in its own scene.
     summary["softcut"] = softcutjob.run(out_dir, size=size, head_ct=not use_phantom and own_data is None)
     if own_data is not None:
-        segmentation_of_roles = roles_segmentation.GetSegmentation()
         summary["own_data"] = {
             "ct": str(own_data.ct),
             "segmentation": str(own_data.segmentation) if own_data.segmentation is not None else None,
-            "segment_names": {segment_id: segmentation_of_roles.GetSegment(segment_id).GetName()
-                              for segment_id in segmentation_of_roles.GetSegmentIDs()},
+            "segment_names": {segment_id: roles.GetSegment(segment_id).GetName() for segment_id in roles.GetSegmentIDs()},
             "warnings": list(own_data.warnings),
         }
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")

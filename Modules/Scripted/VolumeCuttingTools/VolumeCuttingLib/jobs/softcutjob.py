@@ -247,7 +247,9 @@ def run(out_dir: Path, size=(1024, 768), head_ct: bool = True) -> dict:
     timings["carve_s"] = time.perf_counter() - start
     field = module.GetCutField(cut)
     removed = module.GetRemovedVolume(cut)
-    per_segment = {segment_id: round(module.GetRemovedVolumeInSegment(cut, segment_id), 2) for segment_id in segment_ids}
+    per_segment = nodes.by_segment_name(segmentation.GetSegmentation(), {
+        segment_id: {"removed_volume_mm3": round(module.GetRemovedVolumeInSegment(cut, segment_id), 2)}
+        for segment_id in segment_ids})
     undo_steps = field.GetNumberOfUndoSteps()
     undone = module.UndoStroke(cut) and module.GetRemovedVolume(cut) == 0.0
     redone = module.RedoStroke(cut) and abs(module.GetRemovedVolume(cut) - removed) < 1e-6 * max(removed, 1.0)
@@ -291,7 +293,7 @@ def run(out_dir: Path, size=(1024, 768), head_ct: bool = True) -> dict:
         "estimate_triangles": estimate.GetSurface().GetNumberOfPolys(),
         "carve": {
             "removed_volume_mm3": round(removed, 2),
-            "removed_volume_per_segment_mm3": per_segment,
+            "removed_volume_per_segment": per_segment,
             "undo_steps": undo_steps,
             "undo_then_redo_restores": bool(undone and redone),
             "note": "the cut field also removes the air just above the skin (2 voxels) to open it cleanly; "

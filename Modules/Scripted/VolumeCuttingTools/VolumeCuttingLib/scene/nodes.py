@@ -117,3 +117,27 @@ def create_segmentation_from_labels(scene, volume_node, labels_kji, names, name)
         segment.AddRepresentation("Binary labelmap", mask)
         segmentation_node.GetSegmentation().AddSegment(segment, segment_name)
     return segmentation_node
+
+
+def segment_display_names(segmentation, segment_ids):
+    """Each segment ID's name as a person reads it, unique among ``segment_ids``.
+
+    Reports key their figures by these names. Slicer lets two segments share a
+    name (two labelmaps imported with a default name, say), so a shared name
+    gets its ID in brackets rather than one segment's figures overwriting the
+    other's; a segment without a name shows its ID.
+    """
+    names = {}
+    for segment_id in segment_ids:
+        segment = segmentation.GetSegment(segment_id)
+        if segment is None:
+            raise ValueError(f"segment {segment_id!r} is not in the segmentation")
+        names[segment_id] = segment.GetName() or segment_id
+    shared = {name for name in names.values() if list(names.values()).count(name) > 1}
+    return {segment_id: f"{name} ({segment_id})" if name in shared else name for segment_id, name in names.items()}
+
+
+def by_segment_name(segmentation, figures_by_id):
+    """``{name: {"segment_id": ID, **figures}}`` from ``{ID: {figure: value}}``, in the given order."""
+    names = segment_display_names(segmentation, list(figures_by_id))
+    return {names[segment_id]: {"segment_id": segment_id, **figures} for segment_id, figures in figures_by_id.items()}
