@@ -234,10 +234,12 @@ int vtkSlicerVolumeCuttingHapticSession::Update()
     this->FootSwitch->ProcessConnectionEvents();
   }
   const int cuts = this->Loop->ProcessEvents();
-  // The tool where the haptic thread last put it, through the logic as any pose source.
+  // The tool where the haptic thread last put it, through the logic as any
+  // pose source; only the glyph follows: the haptic thread is the field's
+  // writer, and the loop's preparer builds the shield ahead of it.
   if (this->Logic && this->Loop->GetLatestToolPose(this->Pose))
   {
-    this->Logic->MoveActiveTool(this->CutNode, this->Pose, vtkSlicerVolumeCuttingLogic::ToolMove);
+    this->Logic->MoveActiveTool(this->CutNode, this->Pose, vtkSlicerVolumeCuttingLogic::ToolFollow);
   }
   if ((cuts > 0) != this->Drilling)
   {

@@ -159,7 +159,11 @@ public:
   {
     ToolMove = 0,
     ToolCut,
-    ToolRestore
+    ToolRestore,
+    /// The transform only: a tool whose strokes another thread cuts (a
+    /// haptic session's), whose shield that thread's preparer builds; the
+    /// caller must not touch the field the other thread writes.
+    ToolFollow
   };
   /// Move the active tool to a pose, from any source (mouse, haptic device,
   /// replay): its transform node follows (views draw the tool there), and

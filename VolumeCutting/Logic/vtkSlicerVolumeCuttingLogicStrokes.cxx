@@ -232,6 +232,10 @@ bool vtkSlicerVolumeCuttingLogic::MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, 
   {
     transform->SetMatrixTransformToParent(toolToRAS);
   }
+  if (action == ToolFollow)
+  {
+    return true;
+  }
   vtkVolumeCutField* field = cutNode->GetCutField();
   bool accepted = true;
   if (action == ToolMove && !(field && field->IsStrokeOpen()) && (field = this->GetCutField(cutNode)) != nullptr)

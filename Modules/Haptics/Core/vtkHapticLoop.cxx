@@ -13,6 +13,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutTool.h"
 
 #include <algorithm>
@@ -150,6 +151,16 @@ struct vtkHapticLoop::Internals
   std::atomic<unsigned long long> Jittered{ 0 };
   std::atomic<unsigned long long> Overruns{ 0 };
   bool RealTime = false;
+  /// Per kept tick, in the same slot as its duration: the cut stroke's time and the shield bricks it built.
+  std::vector<float> CutDurations;
+  std::vector<unsigned short> ShieldBuilds;
+  unsigned long long ShieldBricksInTicks = 0;
+
+  // The preparer thread (see Shield in the header).
+  std::thread Preparer;
+  std::atomic<bool> PreparerStopRequested{ false };
+  /// The tool's reach around its pose (mm), set by Prepare.
+  double ToolReach = 0.0;
 
   /// Haptic thread: a report for the main thread (counted, not kept, when the ring is full).
   void Push(unsigned long long tick, int type, const double p0[3] = nullptr, const double p1[3] = nullptr)
@@ -402,6 +413,7 @@ bool vtkHapticLoop::Prepare()
   }
   internal.Tool = internal.Model->GetTool();
   internal.Radius = internal.Model->GetSphereRadius();
+  internal.ToolReach = internal.Tool ? internal.Tool->GetBoundingRadius() : internal.Radius;
   if (internal.Recorder)
   {
     internal.Recorder->GetCapabilities()->DeepCopy(capabilities);
@@ -410,6 +422,9 @@ bool vtkHapticLoop::Prepare()
   internal.Durations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.ProcessorDurations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.Jitters.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
+  internal.CutDurations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
+  internal.ShieldBuilds.assign(static_cast<size_t>(this->StatisticsCapacity), 0);
+  internal.ShieldBricksInTicks = 0;
   internal.Timed = 0;
   internal.Jittered = 0;
   internal.Overruns = 0;
@@ -445,6 +460,11 @@ bool vtkHapticLoop::Start()
   internal.RealTime = false;
   internal.Running = true;
   internal.Thread = std::thread([this]() { this->Run(); });
+  if (this->PrepareShieldAhead && internal.Field && internal.Field->GetProtection()->HasShieldedLabels())
+  {
+    internal.PreparerStopRequested = false;
+    internal.Preparer = std::thread([this]() { this->PrepareShield(); });
+  }
 #if defined(__linux__)
   // Real-time priority and a processor of its own where the system grants
   // them (it usually refuses both to unprivileged users: then the loop runs
@@ -467,6 +487,11 @@ bool vtkHapticLoop::Start()
 void vtkHapticLoop::Stop()
 {
   Internals& internal = *this->Internal;
+  if (internal.Preparer.joinable())
+  {
+    internal.PreparerStopRequested = true;
+    internal.Preparer.join();
+  }
   if (internal.Thread.joinable())
   {
     internal.StopRequested = true;
@@ -565,6 +590,32 @@ void vtkHapticLoop::Run()
 }
 
 //------------------------------------------------------------------------------
+void vtkHapticLoop::PrepareShield()
+{
+  Internals& internal = *this->Internal;
+  const double reach = internal.ToolReach + this->ShieldLookAhead;
+  // Prepare again once the tool has used a quarter of the look-ahead.
+  const double step = std::max(0.1, 0.25 * this->ShieldLookAhead);
+  // Before the first tick the tool is at the device's workspace centre.
+  double last[3] = { internal.DeviceToRAS[0][3], internal.DeviceToRAS[1][3], internal.DeviceToRAS[2][3] };
+  internal.Field->PrepareProtectionAhead(last, reach);
+  while (!internal.PreparerStopRequested.load(std::memory_order_acquire))
+  {
+    Display display;
+    if (internal.Latest.Load(display))
+    {
+      const double position[3] = { display.ToolToRAS[3], display.ToolToRAS[7], display.ToolToRAS[11] };
+      if (vtkMath::Distance2BetweenPoints(position, last) > step * step)
+      {
+        internal.Field->PrepareProtectionAhead(position, reach);
+        std::copy(position, position + 3, last);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkHapticLoop::SafeStop()
 {
   Internals& internal = *this->Internal;
@@ -602,6 +653,10 @@ void vtkHapticLoop::Tick(double timeStep)
   Internals& internal = *this->Internal;
   const unsigned long long tick = internal.TickCount.load(std::memory_order_relaxed);
   internal.TickCount.store(tick + 1, std::memory_order_release);
+  // This tick's slot in the statistics: the one its duration goes to.
+  const size_t slot = internal.Timed.load(std::memory_order_relaxed) % internal.Durations.size();
+  internal.CutDurations[slot] = 0.0f;
+  internal.ShieldBuilds[slot] = 0;
   vtkHapticDevice* device = internal.Device;
   device->Synchronize(tick);
   if (internal.Switch)
@@ -701,6 +756,9 @@ void vtkHapticLoop::Tick(double timeStep)
   bool cut = false;
   if (drilling && result.Cut)
   {
+    vtkVolumeCutProtection* protection = internal.Field->GetProtection();
+    const vtkIdType shieldBefore = protection->GetNumberOfBricksBuiltOnDemand();
+    const Clock::time_point cutStart = Clock::now();
     const double* p1 = result.CutPosition;
     const double* p0 = internal.LastCutValid ? internal.LastCut : p1;
     // A jump longer than the field accepts (the proxy is limited per tick,
@@ -728,6 +786,10 @@ void vtkHapticLoop::Tick(double timeStep)
     {
       cut = internal.Field->CutCapsule(p0, p1, internal.Radius);
     }
+    internal.CutDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - cutStart).count();
+    const vtkIdType shieldBuilt = protection->GetNumberOfBricksBuiltOnDemand() - shieldBefore;
+    internal.ShieldBuilds[slot] = static_cast<unsigned short>(std::min<vtkIdType>(std::max<vtkIdType>(shieldBuilt, 0), 65535));
+    internal.ShieldBricksInTicks += static_cast<unsigned long long>(std::max<vtkIdType>(shieldBuilt, 0));
     internal.Push(tick, cut ? CutEvent : FailedCutEvent, p0, p1);
     if (cut)
     {
@@ -914,6 +976,45 @@ unsigned long long vtkHapticLoop::GetNumberOfOverruns() const
 }
 
 //------------------------------------------------------------------------------
+double vtkHapticLoop::GetCutDurationPercentile(double percent) const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.CutDurations.size());
+  return Percentile(std::vector<float>(internal.CutDurations.begin(), internal.CutDurations.begin() + count), percent);
+}
+
+//------------------------------------------------------------------------------
+unsigned long long vtkHapticLoop::GetNumberOfShieldBricksBuiltInTicks() const
+{
+  return this->Internal->ShieldBricksInTicks;
+}
+
+//------------------------------------------------------------------------------
+unsigned long long vtkHapticLoop::GetNumberOfTicksBuildingShield() const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.ShieldBuilds.size());
+  return static_cast<unsigned long long>(
+    std::count_if(internal.ShieldBuilds.begin(), internal.ShieldBuilds.begin() + count, [](unsigned short built) { return built > 0; }));
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetMaximumTickDurationBuildingShield() const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.ShieldBuilds.size());
+  float longest = 0.0f;
+  for (size_t n = 0; n < count; ++n)
+  {
+    if (internal.ShieldBuilds[n] > 0)
+    {
+      longest = std::max(longest, internal.Durations[n]);
+    }
+  }
+  return longest;
+}
+
+//------------------------------------------------------------------------------
 bool vtkHapticLoop::GetRealTimePriority() const
 {
   return this->Internal->RealTime;
@@ -930,6 +1031,7 @@ void vtkHapticLoop::ResetStatistics()
   this->Internal->Timed = 0;
   this->Internal->Jittered = 0;
   this->Internal->Overruns = 0;
+  this->Internal->ShieldBricksInTicks = 0;
 }
 
 //------------------------------------------------------------------------------
@@ -944,5 +1046,7 @@ void vtkHapticLoop::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Running: " << (this->IsRunning() ? "yes" : "no") << "\n";
   os << indent << "NumberOfTicks: " << this->GetNumberOfTicks() << "\n";
   os << indent << "NumberOfCutStrokes: " << this->NumberOfCutStrokes << "\n";
+  os << indent << "PrepareShieldAhead: " << (this->PrepareShieldAhead ? "on" : "off") << "\n";
+  os << indent << "ShieldLookAhead: " << this->ShieldLookAhead << " mm\n";
   os << indent << "DeviceScale: " << this->GetDeviceScale() << "\n";
 }

@@ -23,6 +23,15 @@
  * and copies a brick once per stroke for undo; everything else in the tick
  * is allocated by Start.
  *
+ * Shield. Where structures are protected, the field's shield is built a
+ * brick at a time where a tool first reaches it; built in a tick, a ring of
+ * such bricks costs milliseconds. With PrepareShieldAhead (the default) a
+ * second thread, the preparer, follows the tool's latest pose (the display
+ * value, lock-free) and builds the shield within ShieldLookAhead of the
+ * tool's reach before the tool gets there (vtkVolumeCutField::PrepareProtectionAhead);
+ * the tick takes the prepared bricks without waiting and builds only what
+ * was not prepared in time (counted: GetNumberOfShieldBricksBuiltInTicks).
+ *
  * Safety. A device that is lost (unplugged, silent) or gives no sample
  * stops the drill at once: the open stroke is closed (every cut made stays,
  * as one undo step), the force is zero. When the device is back the proxy
@@ -129,6 +138,19 @@ public:
 
   ///@{
   /**
+   * Set/get whether a preparer thread builds the shield around the tool
+   * ahead of the ticks (see Shield above), and how far beyond the tool's
+   * reach (mm). Defaults: on, 3 mm. Set while stopped.
+   */
+  vtkSetMacro(PrepareShieldAhead, bool);
+  vtkGetMacro(PrepareShieldAhead, bool);
+  vtkBooleanMacro(PrepareShieldAhead, bool);
+  vtkSetClampMacro(ShieldLookAhead, double, 0.0, 50.0);
+  vtkGetMacro(ShieldLookAhead, double);
+  ///@}
+
+  ///@{
+  /**
    * Set/get the processor the thread asks to run on (-1: any). Default is -1.
    */
   vtkSetMacro(ProcessorIndex, int);
@@ -220,6 +242,20 @@ public:
   double GetMaximumPeriodJitter() const;
   unsigned long long GetNumberOfOverruns() const;
   bool GetRealTimePriority() const;
+  ///@}
+
+  ///@{
+  /**
+   * Where the ticks' time goes, over the ticks kept, in microseconds: the
+   * percentiles of the cut stroke's part of a tick (0 in ticks that cut
+   * nothing); the shield bricks the haptic thread built itself in its cut
+   * strokes (none were prepared in time), the ticks that built any, and the
+   * longest of those ticks (0 if none). Read them while stopped.
+   */
+  double GetCutDurationPercentile(double percent) const;
+  unsigned long long GetNumberOfShieldBricksBuiltInTicks() const;
+  unsigned long long GetNumberOfTicksBuildingShield() const;
+  double GetMaximumTickDurationBuildingShield() const;
   void ResetStatistics();
   ///@}
 
@@ -229,6 +265,8 @@ protected:
 
   bool Prepare();
   void Run();
+  /// The preparer thread's work (see Shield above).
+  void PrepareShield();
   void Tick(double timeStep);
   void SafeStop();
   void Finish();
@@ -238,6 +276,8 @@ protected:
   double SpinTime = 0.0002;
   int ProcessorIndex = -1;
   int StatisticsCapacity = 100000;
+  bool PrepareShieldAhead = true;
+  double ShieldLookAhead = 3.0;
   int NumberOfCutStrokes = 0;
   int NumberOfDrillPresses = 0;
   int NumberOfDrillReleases = 0;

@@ -227,11 +227,37 @@ void vtkVolumeCutField::ResetContact()
 //------------------------------------------------------------------------------
 vtkIdType vtkVolumeCutField::PrepareProtection(const double center[3], double radius)
 {
-  if (!this->Directory || !center || !IsFinite(center) || !(radius >= 0.0) || !this->Protection->HasShieldedLabels())
+  if (!this->CollectProtectionBricks(center, radius, this->PreparationBrickIds))
   {
     return 0;
   }
   const vtkIdType before = this->Protection->GetNumberOfBuiltBricks();
+  for (vtkIdType brickId : this->PreparationBrickIds)
+  {
+    this->GetProtectionBrick(brickId);
+  }
+  return this->Protection->GetNumberOfBuiltBricks() - before;
+}
+
+//------------------------------------------------------------------------------
+vtkIdType vtkVolumeCutField::PrepareProtectionAhead(const double center[3], double radius)
+{
+  std::vector<vtkIdType> brickIds;
+  if (!this->CollectProtectionBricks(center, radius, brickIds))
+  {
+    return 0;
+  }
+  return this->Protection->PrepareBricks(brickIds.data(), static_cast<vtkIdType>(brickIds.size()));
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutField::CollectProtectionBricks(const double center[3], double radius, std::vector<vtkIdType>& brickIds) const
+{
+  brickIds.clear();
+  if (!this->Directory || !center || !IsFinite(center) || !(radius >= 0.0) || !this->Protection->HasShieldedLabels())
+  {
+    return false;
+  }
   const double reach = radius + this->BandWidth;
   // The bricks of the sub-voxel box around the ball, then those the ball meets.
   int lower[3] = { std::numeric_limits<int>::max(), std::numeric_limits<int>::max(), std::numeric_limits<int>::max() };
@@ -270,12 +296,12 @@ vtkIdType vtkVolumeCutField::PrepareProtection(const double center[3], double ra
         Transform(this->SubIJKToRAS, centerSample, brickCenter);
         if (vtkMath::Distance2BetweenPoints(brickCenter, center) <= limit * limit)
         {
-          this->GetProtectionBrick((static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi);
+          brickIds.push_back((static_cast<vtkIdType>(bk) * this->BrickDimensions[1] + bj) * this->BrickDimensions[0] + bi);
         }
       }
     }
   }
-  return this->Protection->GetNumberOfBuiltBricks() - before;
+  return true;
 }
 
 //------------------------------------------------------------------------------

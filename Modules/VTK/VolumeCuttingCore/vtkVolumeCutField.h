@@ -230,6 +230,16 @@ public:
   vtkIdType PrepareProtection(const double center[3], double radius);
 
   /**
+   * Build the same bricks as PrepareProtection on the calling thread, which
+   * is not the writer's, while the writer may cut: the writer finds them
+   * built when it reaches them, without waiting (vtkVolumeCutProtection::PrepareBricks). For a writer with a deadline:
+   * the haptic thread's preparer calls it around the tool. Not while the
+   * field's geometry or the shield's images or table change. Returns the
+   * number of bricks built.
+   */
+  vtkIdType PrepareProtectionAhead(const double center[3], double radius);
+
+  /**
    * Shield structures given as one label image with the anatomy's dimensions
    * (IJK geometry; one integer component): 0 for voxels a tool may cut, k > 0
    * for the k-th protected structure (labels above 255 are reported as 255).
@@ -474,6 +484,10 @@ protected:
   void Reset();
   /// The shield of a brick (built on first reach), nullptr where the tool cuts freely.
   const vtkVolumeCutProtection::Brick* GetProtectionBrick(vtkIdType brickId);
+  /// The bricks whose shield a tool at center with the given reach may need; false if there is no shield.
+  bool CollectProtectionBricks(const double center[3], double radius, std::vector<vtkIdType>& brickIds) const;
+  /// PrepareProtection's list, kept between calls (writer only).
+  std::vector<vtkIdType> PreparationBrickIds;
 
   int Dimensions[3] = { 0, 0, 0 };
   int BrickDimensions[3] = { 0, 0, 0 };

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 
 vtkStandardNewMacro(vtkVolumeCutProtection);
 
@@ -48,7 +49,10 @@ void ReadLabels(const T* first, const vtkIdType increments[3], const int count[3
 vtkVolumeCutProtection::vtkVolumeCutProtection() = default;
 
 //------------------------------------------------------------------------------
-vtkVolumeCutProtection::~vtkVolumeCutProtection() = default;
+vtkVolumeCutProtection::~vtkVolumeCutProtection()
+{
+  this->ReleaseBricks();
+}
 
 //------------------------------------------------------------------------------
 int vtkVolumeCutProtection::AddLabelImage(vtkImageData* image)
@@ -215,38 +219,112 @@ void vtkVolumeCutProtection::SetFieldGeometry(
   this->SubVoxelFactor = subVoxelFactor;
   this->BandWidth = bandWidth;
   this->Quantum = quantum;
-  this->ClearBricks();
+  std::lock_guard<std::mutex> preparer(this->PreparerMutex);
+  this->ReleaseBricks();
+  const vtkIdType size = static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1] * this->BrickDimensions[2];
+  if (size != this->DirectorySize)
+  {
+    this->Directory.reset(size > 0 ? new std::atomic<Brick*>[size] : nullptr);
+    this->DirectorySize = size > 0 ? size : 0;
+    for (vtkIdType n = 0; n < this->DirectorySize; ++n)
+    {
+      this->Directory[n].store(nullptr, std::memory_order_relaxed);
+    }
+  }
   this->Modified();
 }
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutProtection::ClearBricks()
 {
-  this->Bricks.clear();
-  this->NumberOfShieldBricks = 0;
+  std::lock_guard<std::mutex> preparer(this->PreparerMutex);
+  this->ReleaseBricks();
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::ReleaseBricks()
+{
+  Brick* const freeBrick = FreeBrick();
+  for (vtkIdType n = 0; n < this->DirectorySize; ++n)
+  {
+    Brick* brick = this->Directory[n].exchange(nullptr, std::memory_order_acq_rel);
+    if (brick != freeBrick)
+    {
+      delete brick;
+    }
+  }
+  this->BuiltBricks.store(0, std::memory_order_release);
+  this->ShieldBricks.store(0, std::memory_order_release);
+  this->PreparedBricks.store(0, std::memory_order_release);
+  this->BricksBuiltOnDemand = 0;
+}
+
+//------------------------------------------------------------------------------
+vtkVolumeCutProtection::Brick* vtkVolumeCutProtection::FreeBrick()
+{
+  // An address no brick can have; only compared, never read.
+  static char mark;
+  return reinterpret_cast<Brick*>(&mark);
+}
+
+//------------------------------------------------------------------------------
+const vtkVolumeCutProtection::Brick* vtkVolumeCutProtection::Publish(vtkIdType brickId, std::unique_ptr<Brick> built)
+{
+  Brick* const value = built ? built.get() : FreeBrick();
+  Brick* expected = nullptr;
+  if (this->Directory[brickId].compare_exchange_strong(expected, value, std::memory_order_acq_rel, std::memory_order_acquire))
+  {
+    const bool shielded = built != nullptr;
+    built.release(); // the directory owns it now
+    this->BuiltBricks.fetch_add(1, std::memory_order_acq_rel);
+    this->ShieldBricks.fetch_add(shielded ? 1 : 0, std::memory_order_acq_rel);
+    return shielded ? value : nullptr;
+  }
+  // The other side was first: its brick is the same shield; ours is dropped.
+  return expected == FreeBrick() ? nullptr : expected;
+}
+
+//------------------------------------------------------------------------------
+vtkIdType vtkVolumeCutProtection::PrepareBricks(const vtkIdType* brickIds, vtkIdType count)
+{
+  if (!brickIds || count <= 0 || this->SubVoxelFactor < 1 || this->LabelImages.empty())
+  {
+    return 0;
+  }
+  std::lock_guard<std::mutex> preparer(this->PreparerMutex);
+  vtkIdType built = 0;
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    const vtkIdType brickId = brickIds[n];
+    if (brickId < 0 || brickId >= this->DirectorySize || this->Directory[brickId].load(std::memory_order_acquire))
+    {
+      continue;
+    }
+    this->Publish(brickId, this->BuildBrick(brickId, this->PrepareScratch));
+    ++built;
+    this->PreparedBricks.fetch_add(1, std::memory_order_acq_rel);
+  }
+  return built;
 }
 
 //------------------------------------------------------------------------------
 const vtkVolumeCutProtection::Brick* vtkVolumeCutProtection::GetBrick(vtkIdType brickId)
 {
-  if (this->SubVoxelFactor < 1 || this->LabelImages.empty())
+  if (this->SubVoxelFactor < 1 || this->LabelImages.empty() || brickId < 0 || brickId >= this->DirectorySize)
   {
     return nullptr;
   }
-  auto found = this->Bricks.find(brickId);
-  if (found != this->Bricks.end())
+  Brick* const found = this->Directory[brickId].load(std::memory_order_acquire);
+  if (found)
   {
-    return found->second.get();
+    return found == FreeBrick() ? nullptr : found;
   }
-  std::unique_ptr<Brick> built = this->BuildBrick(brickId);
-  const Brick* brick = built.get();
-  this->NumberOfShieldBricks += brick != nullptr;
-  this->Bricks.emplace(brickId, std::move(built));
-  return brick;
+  ++this->BricksBuiltOnDemand;
+  return this->Publish(brickId, this->BuildBrick(brickId, this->BuildScratch));
 }
 
 //------------------------------------------------------------------------------
-std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBrick(vtkIdType brickId) const
+std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBrick(vtkIdType brickId, Scratch& scratch) const
 {
   const int f = this->SubVoxelFactor;
   const int brickIndex[3] = { static_cast<int>(brickId % this->BrickDimensions[0]),
@@ -270,7 +348,6 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
     upper[axis] = own[axis][BrickSize - 1] + this->Reach[axis];
     size[axis] = upper[axis] - lower[axis] + 1;
   }
-  Scratch& scratch = this->BuildScratch;
   const size_t blockCount = static_cast<size_t>(size[0]) * size[1] * size[2];
   scratch.Labels.resize(blockCount);
   uint8_t* labels = scratch.Labels.data();
@@ -467,10 +544,8 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
 //------------------------------------------------------------------------------
 size_t vtkVolumeCutProtection::GetMemorySize() const
 {
-  size_t bytes = static_cast<size_t>(this->NumberOfShieldBricks) * sizeof(Brick);
-  // The hash table's nodes and buckets.
-  bytes += this->Bricks.size() * (sizeof(vtkIdType) + sizeof(std::unique_ptr<Brick>) + 2 * sizeof(void*));
-  bytes += this->Bricks.bucket_count() * sizeof(void*);
+  size_t bytes = static_cast<size_t>(this->GetNumberOfShieldBricks()) * sizeof(Brick);
+  bytes += static_cast<size_t>(this->DirectorySize) * sizeof(std::atomic<Brick*>);
   for (const LabelImage& entry : this->LabelImages)
   {
     bytes += entry.Labels.capacity();
@@ -485,6 +560,8 @@ void vtkVolumeCutProtection::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LabelImages: " << this->LabelImages.size() << "\n";
   os << indent << "HasShieldedLabels: " << (this->HasShieldedLabels() ? "yes" : "no") << "\n";
   os << indent << "Reach (voxels): " << this->Reach[0] << " " << this->Reach[1] << " " << this->Reach[2] << "\n";
-  os << indent << "BuiltBricks: " << this->GetNumberOfBuiltBricks() << " (" << this->NumberOfShieldBricks << " with a shield)\n";
+  os << indent << "BuiltBricks: " << this->GetNumberOfBuiltBricks() << " (" << this->GetNumberOfShieldBricks() << " with a shield)\n";
+  os << indent << "BricksBuiltOnDemand: " << this->BricksBuiltOnDemand << "\n";
+  os << indent << "PreparedBricks: " << this->GetNumberOfPreparedBricks() << "\n";
   os << indent << "MemorySize: " << this->GetMemorySize() << " bytes\n";
 }

@@ -26,6 +26,13 @@
  * Threads: the images and the table are changed, and bricks are built, by the
  * field's writer (or while no writer runs); GetShieldLabel may be called by
  * readers while the writer cuts, provided the images and the table do not change.
+ * Another thread may build bricks ahead of the writer (PrepareBricks) while
+ * the writer cuts. Built bricks are published in a directory of atomic
+ * pointers, one a brick of the field: whoever builds a brick first puts it
+ * there, the other drops its copy. A writer with a deadline (the haptic
+ * thread) thus never waits for a preparation and never moves what was
+ * prepared: it finds built what was prepared in time, and builds the rest
+ * itself, as without a preparer.
  */
 
 #ifndef vtkVolumeCutProtection_h
@@ -36,9 +43,10 @@
 #include "vtkVolumeCuttingCoreExport.h" // For export macro
 
 #include <cstdint>       // For uint8_t
-#include <memory>        // For std::unique_ptr
-#include <unordered_map> // For the built bricks
-#include <vector>        // For the label images
+#include <atomic> // For the brick directory
+#include <memory> // For std::unique_ptr
+#include <mutex>  // For serialising preparers
+#include <vector> // For the label images
 
 class vtkImageData;
 
@@ -109,20 +117,47 @@ public:
 
   ///@{
   /// Bricks built so far (those with a shield and those found free) and the memory they use.
-  vtkIdType GetNumberOfBuiltBricks() const { return static_cast<vtkIdType>(this->Bricks.size()); }
-  vtkIdType GetNumberOfShieldBricks() const { return this->NumberOfShieldBricks; }
+  vtkIdType GetNumberOfBuiltBricks() const { return this->BuiltBricks.load(std::memory_order_acquire); }
+  vtkIdType GetNumberOfShieldBricks() const { return this->ShieldBricks.load(std::memory_order_acquire); }
   size_t GetMemorySize() const;
   ///@}
 
-  /// Forget the bricks built so far (they are built again when reached).
+  /**
+   * Bricks GetBrick had to build itself because no preparation had built
+   * them (the cost a writer with a deadline must not pay; writer's thread),
+   * and bricks built by PrepareBricks (with or without a shield). Counted
+   * since SetFieldGeometry or ClearBricks.
+   */
+  vtkIdType GetNumberOfBricksBuiltOnDemand() const { return this->BricksBuiltOnDemand; }
+  vtkIdType GetNumberOfPreparedBricks() const { return this->PreparedBricks.load(std::memory_order_acquire); }
+
+  /**
+   * Build the given bricks on the calling thread, skipping those built
+   * already, for the writer to find built when it reaches them. Safe while
+   * the writer cuts (not while the images, the table or the geometry
+   * change). Calls from several threads are serialised. Returns the number
+   * of bricks built.
+   */
+  vtkIdType PrepareBricks(const vtkIdType* brickIds, vtkIdType count);
+
+  /// Forget the bricks built so far (they are built again when reached). Not while the writer cuts; waits for a preparation.
   void ClearBricks();
 
 protected:
   vtkVolumeCutProtection();
   ~vtkVolumeCutProtection() override;
 
-  /// Builds the shield of one brick; nullptr where it would be free.
-  std::unique_ptr<Brick> BuildBrick(vtkIdType brickId) const;
+  struct Scratch;
+  /// Builds the shield of one brick in scratch's working memory; nullptr where it would be free.
+  std::unique_ptr<Brick> BuildBrick(vtkIdType brickId, Scratch& scratch) const;
+  /**
+   * Put a brick just built (nullptr: free) into the directory unless the
+   * other side did first; returns the brick the directory holds then
+   * (nullptr: free). Counts it if it went in.
+   */
+  const Brick* Publish(vtkIdType brickId, std::unique_ptr<Brick> built);
+  /// Free every built brick and empty the directory.
+  void ReleaseBricks();
 
   struct LabelImage
   {
@@ -141,10 +176,22 @@ protected:
   /// Anatomy voxels within the band of a sample, along each axis.
   int Reach[3] = { 1, 1, 1 };
 
-  std::unordered_map<vtkIdType, std::unique_ptr<Brick>> Bricks;
-  vtkIdType NumberOfShieldBricks = 0;
+  /**
+   * The built bricks by brick ID: nullptr not built yet, FreeBrick() built
+   * and free, else the brick's shield (owned). Sized by SetFieldGeometry.
+   */
+  std::unique_ptr<std::atomic<Brick*>[]> Directory;
+  vtkIdType DirectorySize = 0;
+  /// The directory's mark of a brick built and found free (never dereferenced).
+  static Brick* FreeBrick();
+  std::atomic<vtkIdType> BuiltBricks{ 0 };
+  std::atomic<vtkIdType> ShieldBricks{ 0 };
+  vtkIdType BricksBuiltOnDemand = 0;
+  std::atomic<vtkIdType> PreparedBricks{ 0 };
+  /// Serialises preparers, and ClearBricks with them (the writer's GetBrick never takes it).
+  std::mutex PreparerMutex;
 
-  /// BuildBrick's working memory, kept between bricks (built by the writer only).
+  /// BuildBrick's working memory, kept between bricks (one for the writer, one for the preparer).
   struct Scratch
   {
     std::vector<uint8_t> Labels;
@@ -157,7 +204,8 @@ protected:
     std::vector<uint8_t> RowFound;
     std::vector<uint8_t> SliceFound;
   };
-  mutable Scratch BuildScratch;
+  Scratch BuildScratch;
+  Scratch PrepareScratch;
 
 private:
   vtkVolumeCutProtection(const vtkVolumeCutProtection&) = delete;

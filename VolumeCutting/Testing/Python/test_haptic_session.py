@@ -256,3 +256,29 @@ def test_main_job_haptics_replays_a_recorded_session_through_the_loop(tmp_path):
     first = slicer.vtkHapticRecorder()
     assert first.ReadFile(str(tmp_path / "haptic_replay.vchr"))
     assert first.GetNumberOfTicks() == summary["ticks_run"]
+
+
+def test_the_haptic_thread_builds_no_shield_brick_when_the_preparer_runs_ahead(tmp_path):
+    """A replay towards a protected nerve: its shield is built off the haptic thread, with the same cut."""
+    application, logic, cut = block_scene()
+    # Drilled from the block's right face along -x, 2.5 mm above the nerve's axis: the burr grazes the nerve.
+    plan = SimpleNamespace(entry=np.array([7.5, 0.0, 10.5]), direction=np.array([-1.0, 0.0, 0.0]), surface_radius=2.0)
+    protection = logic.GetCutField(cut).GetProtection()
+    summaries = {}
+    for ahead in (False, True):
+        logic.ClearCut(cut)
+        protection.ClearBricks()
+        (tmp_path / str(ahead)).mkdir()
+        summaries[ahead] = hapticsjob.run(application, cut, plan, tmp_path / str(ahead), prepare_shield_ahead=ahead)
+    without, with_preparer = summaries[False], summaries[True]
+    assert without["protected_segments"] == with_preparer["protected_segments"] == 1
+    # Without the preparer the ticks that first reach the nerve's band build its shield themselves (the old behaviour).
+    assert without["shield_bricks_built_in_ticks"] > 0 and without["ticks_building_shield"] > 0
+    # With it, every brick the strokes reached was built ahead, off the haptic thread.
+    assert with_preparer["shield_bricks_built_in_ticks"] == 0 and with_preparer["ticks_building_shield"] == 0
+    assert with_preparer["tick_us_max_building_shield"] == 0.0
+    assert with_preparer["shield_bricks_prepared_ahead"] > 0 and without["shield_bricks_prepared_ahead"] == 0
+    # The shield is the same whoever built it: the same cut, nothing of the nerve removed.
+    assert with_preparer["removed_volume_mm3"] == pytest.approx(without["removed_volume_mm3"], abs=0.01)
+    assert with_preparer["removed_volume_mm3"] > 1.0
+    assert logic.GetRemovedVolumeInSegment(cut, "Nerve") == 0.0

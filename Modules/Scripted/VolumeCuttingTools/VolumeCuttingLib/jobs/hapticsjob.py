@@ -113,12 +113,15 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
     return recorder.GetNumberOfTicks()
 
 
-def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
+def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
     update (a view's render: the views draw the field while the haptic thread
     cuts it); otherwise this thread sleeps a display period between updates.
+    ``prepare_shield_ahead`` False leaves the shield of protected structures
+    to be built by the haptic thread where it first reaches it (the
+    comparison for the loop's preparer, ``vtkHapticLoop.SetPrepareShieldAhead``).
     """
     logic = application.volume_cutting_logic
     scene = application.scene
@@ -148,6 +151,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
     session.SetLogic(logic)
     loop = session.GetLoop()
     loop.SetRate(RATE_HZ)
+    loop.SetPrepareShieldAhead(bool(prepare_shield_ahead))
     replayed = slicer.vtkHapticRecorder()
     replayed.SetCapacity(ticks + 1000)
     loop.SetRecorder(replayed)
@@ -160,6 +164,8 @@ def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
         cut_node.RemoveObserver(observer)
         raise RuntimeError("the haptic session could not start (see the log)")
     frames = 0
+    # The node's field as the loop cuts it (the logic's GetCutField may rebuild its shield: not while the loop runs).
+    protection = cut_node.GetCutField().GetProtection()
     try:
         while not replay.IsFinished():
             if frame is None:
@@ -169,6 +175,8 @@ def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
                 frame()
             frames += 1
     finally:
+        # Read before Stop: ending the stroke may bring the logic's shield up to date, which forgets its bricks.
+        shield_bricks_prepared = protection.GetNumberOfPreparedBricks()
         session.Stop()
         cut_node.RemoveObserver(observer)
     wall_s = time.perf_counter() - started
@@ -220,6 +228,14 @@ def run(application, cut_node, plan, out_dir: Path, frame=None) -> dict:
         "tick_cpu_us_max": round(loop.GetTickProcessorTimePercentile(100.0), 1),
         "period_jitter_us_p99": round(loop.GetPeriodJitterPercentile(99.0), 1),
         "overruns": int(loop.GetNumberOfOverruns()),
+        "cut_us_p99": round(loop.GetCutDurationPercentile(99.0), 1),
+        "cut_us_max": round(loop.GetCutDurationPercentile(100.0), 1),
+        "prepare_shield_ahead": bool(loop.GetPrepareShieldAhead()),
+        "protected_segments": len(cut_node.GetProtectedSegmentIDs()),
+        "shield_bricks_built_in_ticks": int(loop.GetNumberOfShieldBricksBuiltInTicks()),
+        "shield_bricks_prepared_ahead": int(shield_bricks_prepared),
+        "ticks_building_shield": int(loop.GetNumberOfTicksBuildingShield()),
+        "tick_us_max_building_shield": round(loop.GetMaximumTickDurationBuildingShield(), 1),
         "real_time_priority": bool(loop.GetRealTimePriority()),
         "wall_s": round(wall_s, 2),
     }
