@@ -8,6 +8,8 @@ real head CT (downloaded once into the user cache, never into the repository).
 import sys
 from pathlib import Path
 
+import pytest
+
 MODULE_DIR = Path(__file__).resolve().parents[2]
 if str(MODULE_DIR) not in sys.path:
     sys.path.insert(0, str(MODULE_DIR))
@@ -23,3 +25,16 @@ def pytest_configure(config):
         "markers",
         "browser: drives the web application in Debian's Chromium through Playwright (deselect with -m 'not browser')",
     )
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Debian's Chromium through Playwright, one per test module (the browser tests and the journeys)."""
+    from playwright.sync_api import sync_playwright
+
+    from VolumeCuttingLib.webapp.browser import launch_chromium
+
+    with sync_playwright() as playwright:
+        chromium = launch_chromium(playwright)
+        yield chromium
+        chromium.close()

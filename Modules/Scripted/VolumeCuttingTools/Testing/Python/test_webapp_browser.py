@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer, launch_chromium
+from VolumeCuttingLib.webapp.browser import AppPage, AppServer
 
 pytestmark = pytest.mark.browser
 
@@ -63,16 +63,6 @@ def server(tmp_path_factory, data_dir):
     log = tmp_path_factory.mktemp("webapp-server") / "server.log"
     with AppServer("--phantom", "--max-upload-mb", "1", "--data-dir", data_dir, log_path=log) as running:
         yield running
-
-
-@pytest.fixture(scope="module")
-def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer, launch_chromium
+from VolumeCuttingLib.webapp.browser import AppPage, AppServer
 
 pytestmark = pytest.mark.browser
 
@@ -31,16 +31,6 @@ def shots(tmp_path_factory):
     path = Path(folder) / "journeys" if folder else tmp_path_factory.mktemp("journey-screenshots")
     path.mkdir(parents=True, exist_ok=True)
     return path
-
-
-@pytest.fixture(scope="module")
-def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as playwright:
-        chromium = launch_chromium(playwright)
-        yield chromium
-        chromium.close()
 
 
 def write_nrrd(path: Path, array_kji: np.ndarray, spacing_mm: float, type_name: str) -> Path:
