@@ -65,6 +65,15 @@ HU_DENSE_BONE = 1800.0
 # Tolerance used to accept a direction matrix as orthonormal.
 _ORTHONORMAL_TOLERANCE = 1e-6
 
+# Roles of the phantom's segments in a mastoidectomy: what the drill may remove
+# (the skin and soft tissue over the mastoid are incised and reflected first),
+# the bone among those, and the structures whose injury is the complication the
+# trainee must avoid. The main job and the web application share them.
+CUTTABLE_SEGMENTS = ("SoftTissue", "MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
+BONE_SEGMENTS = ("MastoidCortex", "MastoidBone", "FacialCanalWall")
+PROTECTED_SEGMENTS = (
+    "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
+
 
 # ---------------------------------------------------------------------------
 # Validation helpers

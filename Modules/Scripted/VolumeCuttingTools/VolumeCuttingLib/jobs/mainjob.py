@@ -36,13 +36,9 @@ from ..data import headct, owndata, phantom
 from ..scene.application import HeadlessSlicer
 from ..scene.nodes import array_from_volume_node, by_segment_name, segment_display_names, volume_node_ijk_to_ras
 
-# Roles of the phantom's segments: what a mastoidectomy drill may remove, and
-# the structures whose injury is the complication the trainee must avoid.
-# The skin and soft tissue over the mastoid are incised and reflected first.
-PHANTOM_CUTTABLE_SEGMENTS = ("SoftTissue", "MastoidCortex", "MastoidBone", "MastoidAirCells", "FacialCanalWall")
-PHANTOM_BONE_SEGMENTS = ("MastoidCortex", "MastoidBone", "FacialCanalWall")
-PHANTOM_PROTECTED_SEGMENTS = (
-    "FacialNerve", "SigmoidSinus", "SemicircularCanals", "OticCapsule", "Malleus", "Incus", "Stapes")
+PHANTOM_CUTTABLE_SEGMENTS = phantom.CUTTABLE_SEGMENTS
+PHANTOM_BONE_SEGMENTS = phantom.BONE_SEGMENTS
+PHANTOM_PROTECTED_SEGMENTS = phantom.PROTECTED_SEGMENTS
 
 # On the user's own CT: a short path into the cuttable bone with a 3.5 mm burr.
 OWN_DATA_PLAN = {"surface_radius": 4.0, "depth": 4.0, "burr_radius": 1.75}

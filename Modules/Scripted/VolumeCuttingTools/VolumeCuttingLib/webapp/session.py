@@ -38,7 +38,7 @@ import vtk
 from ..config import toolconfig
 from ..cutting import softcut
 from ..data import headct, owndata, phantom
-from ..jobs import mainjob, softcutjob
+from ..jobs import softcutjob
 from ..scene.application import configure_scene_io
 
 ROLES = (toolconfig.ROLE_CUTTABLE, toolconfig.ROLE_PROTECTED, toolconfig.ROLE_NONE)
@@ -197,7 +197,7 @@ class DrillSession:
         warnings: list[str] = []
         roles = None
         if source == "phantom":
-            roles = (mainjob.PHANTOM_CUTTABLE_SEGMENTS, mainjob.PHANTOM_PROTECTED_SEGMENTS)
+            roles = (phantom.CUTTABLE_SEGMENTS, phantom.PROTECTED_SEGMENTS)
         elif source == "own":
             if ct_path is None:
                 raise SessionError("Give the CT: upload it or name its path on the server")
@@ -255,7 +255,7 @@ class DrillSession:
             cut_node.SetSurfaceIsoValue(SURFACE_ISO_HU)
             cut_node.SetThinBoneShading(True)
             cut_node.SetThinBoneThickness(THIN_BONE_MM)
-            shown = set(mainjob.PHANTOM_PROTECTED_SEGMENTS + mainjob.PHANTOM_BONE_SEGMENTS) if source == "phantom" else None
+            shown = set(phantom.PROTECTED_SEGMENTS + phantom.BONE_SEGMENTS) if source == "phantom" else None
             self._show_segments(roles_segmentation, cut_node, shown)
             tool = toolconfig.create_tool_node(self.scene, self._initial_tool_parameters(), DEFAULT_TOOL)
             created += [tool, self.scene.GetNodeByID(tool.GetTransformNodeID())]
