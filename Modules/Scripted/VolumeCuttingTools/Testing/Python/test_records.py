@@ -325,3 +325,32 @@ def test_the_default_database_is_a_file_in_the_users_data_folder(tmp_path, monke
     assert (tmp_path / "share" / "volumecutting" / "records.sqlite").is_file()
     monkeypatch.setenv(database.ENVIRONMENT_VARIABLE, "postgresql+psycopg://program-server/records")
     assert database.default_database_url() == "postgresql+psycopg://program-server/records"
+
+
+def test_a_session_that_cannot_reach_the_database_is_kept_and_added_later(tmp_path, capsys):
+    from VolumeCuttingLib.records import pending
+
+    unreachable = f"postgresql+psycopg://trainer:secret@127.0.0.1:{closed_loopback_port()}/records"
+    folder = tmp_path / "pending"
+    stored, message = pending.store_or_keep(unreachable, "Ann", make_assessment("offline", score=64.0), folder)
+    assert stored is None
+    kept = folder / f"{sha('offline')}.json"
+    assert message.startswith("cannot open the records database") and str(kept) in message and "secret" not in message
+    assert json.loads(kept.read_text())["assessment"]["score"] == 64.0
+    with pytest.raises(AssessmentError, match="score must be"):  # a bad assessment is refused, not kept
+        pending.store_or_keep(unreachable, "Ann", make_assessment("bad", score=math.nan), folder)
+    assert sorted(p.name for p in folder.iterdir()) == [kept.name]
+    (folder / "garbled.json").write_text("{not json")
+
+    # The database is back: sync adds what was kept and leaves what it cannot read, saying why.
+    url = f"sqlite:///{tmp_path / 'records.sqlite'}"
+    assert cli.main(["--database", url, "sync", "--pending", str(folder)]) == 2
+    out, err = capsys.readouterr()
+    assert out.startswith("1 kept sessions added to sqlite:///") and "garbled.json" in out
+    assert "1 kept sessions could not be added" in err
+    assert not kept.exists() and (folder / "garbled.json").exists()
+    with database.open(url) as records:
+        assert [(s.trainee, s.score) for s in records.sessions("Ann")] == [("Ann", 64.0)]
+        # Reachable now: store_or_keep stores, and a second time changes nothing.
+        stored, message = pending.store_or_keep(url, "Ann", make_assessment("offline", score=64.0), folder)
+        assert not stored.created and message.startswith("stored in the trainee records")

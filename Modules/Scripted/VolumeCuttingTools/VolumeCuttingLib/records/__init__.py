@@ -17,7 +17,8 @@ one upgraded.
         records.learning_curve("A. Resident", ["score", "safety.contacts.FacialNerve"])
 
 Modules: ``assessment`` (what a valid assessment is), ``schema`` (the tables),
-``database`` (open, add, query, migrate), ``localserver`` (a temporary
+``database`` (open, add, query, migrate), ``pending`` (sessions kept while the
+database cannot be reached, added later), ``localserver`` (a temporary
 PostgreSQL cluster for tests and benchmarks), ``__main__`` (the command line,
 ``Utilities/vc records``). Builds on nothing else of the library; the web
 application shows a trainee's progress from it.

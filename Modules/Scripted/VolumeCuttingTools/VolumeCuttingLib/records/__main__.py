@@ -3,13 +3,15 @@
     python -m VolumeCuttingLib.records [--database URL] list
     python -m VolumeCuttingLib.records [--database URL] show TRAINEE [--metric NAME ...] [--json]
     python -m VolumeCuttingLib.records [--database URL] add TRAINEE ASSESSMENT.json [--program P] [--cohort C]
+    python -m VolumeCuttingLib.records [--database URL] sync [--pending FOLDER]
 
 ``--database`` takes a SQLAlchemy URL (``postgresql+psycopg://user:password@host/db``,
 ``sqlite:////path/records.sqlite``) or a file path; the default is
 ``$VOLUMECUTTING_RECORDS`` or ``records.sqlite`` in the user's data folder.
 A refused assessment or an unreachable database ends with exit status 2 and
 a message on stderr; the assessment file is only read, never changed, so it
-can be added again.
+can be added again. ``sync`` adds the sessions kept while the database
+could not be reached (see ``pending``).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import json
 import sys
 from pathlib import Path
 
-from . import database
+from . import database, pending
 from .assessment import AssessmentError
 
 
@@ -39,6 +41,9 @@ def _parser() -> argparse.ArgumentParser:
     add.add_argument("assessment", type=Path, help="the assessment JSON that Utilities/vc assess wrote")
     add.add_argument("--program", default=None, help="the trainee's residency program")
     add.add_argument("--cohort", default=None, help="the trainee's cohort (year group)")
+    sync = commands.add_parser("sync", help="add the sessions kept while the database could not be reached")
+    sync.add_argument("--pending", type=Path, default=None,
+                      help="folder of kept sessions (default: ~/.local/share/volumecutting/pending)")
     return parser
 
 
@@ -95,12 +100,21 @@ def _add(records, args, out) -> None:
           f"({len(stored.metrics)} metrics) in {records}", file=out)
 
 
+def _sync(records, args, out) -> None:
+    stored, left = pending.sync(records, args.pending)
+    print(f"{len(stored)} kept sessions added to {records}" + (f", {len(left)} left:" if left else ""), file=out)
+    for path, reason in left:
+        print(f"  {path}: {reason}", file=out)
+    if left:
+        raise database.RecordsError(f"{len(left)} kept sessions could not be added; they stay where they are")
+
+
 def main(argv=None, out=None) -> int:
     args = _parser().parse_args(argv)
     out = out or sys.stdout
     try:
         with database.open(args.database) as records:
-            {"list": _list, "show": _show, "add": _add}[args.command](records, args, out)
+            {"list": _list, "show": _show, "add": _add, "sync": _sync}[args.command](records, args, out)
     except (database.RecordsError, AssessmentError) as error:
         print(f"vc records: {error}", file=sys.stderr)
         return 2
