@@ -177,10 +177,17 @@ def test_learning_curves_follow_time_not_the_order_of_adding(url):
 
 
 WRITER = textwrap.dedent("""
-    import json, sys
+    import json, sys, time
+    from pathlib import Path
     sys.path.insert(0, sys.argv[1])
     from VolumeCuttingLib.records import database
     documents = json.load(open(sys.argv[3]))
+    # Both writers imported: start together, so that they open the empty database and write at the same time.
+    ready = Path(sys.argv[4])
+    (ready / sys.argv[5]).touch()
+    deadline = time.monotonic() + 60
+    while len(list(ready.iterdir())) < 2 and time.monotonic() < deadline:
+        time.sleep(0.001)
     created = 0
     with database.open(sys.argv[2]) as records:
         for document in documents:
@@ -193,12 +200,14 @@ def test_two_processes_writing_at_once_lose_nothing_and_store_each_recording_onc
     # Both open the database while it is still empty (both migrate), then add 12 sessions each, 6 of them the same.
     common = [make_assessment(f"common{i}", f"2026-11-{i + 1:02d}T10:00:00Z", 10.0 * i) for i in range(6)]
     processes = []
+    ready = tmp_path / "ready"
+    ready.mkdir()
     for writer in ("one", "two"):
         own = [make_assessment(f"{writer}{i}", f"2026-11-{i + 10:02d}T10:00:00Z", 50.0 + i) for i in range(6)]
         documents = common + own if writer == "one" else own + common[::-1]
         path = tmp_path / f"{writer}.json"
         path.write_text(json.dumps(documents))
-        processes.append(subprocess.Popen([sys.executable, "-c", WRITER, str(MODULE_DIR), url, str(path)],
+        processes.append(subprocess.Popen([sys.executable, "-c", WRITER, str(MODULE_DIR), url, str(path), str(ready), writer],
                                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
     results = [process.communicate(timeout=120) for process in processes]
     for process, (out, err) in zip(processes, results):
