@@ -232,6 +232,7 @@ BAD_DOCUMENTS = {
     "infinite metric": (lambda d: d["metrics"].update({"final.dice": math.inf}), "metric final.dice must be a finite"),
     "true as a metric": (lambda d: d["metrics"].update({"safety.burr": True}), "metric safety.burr must be a finite"),
     "bad time": (lambda d: d["session"].update(started="yesterday"), "ISO 8601 time, got 'yesterday'"),
+    "NaN in the reference": (lambda d: d.update(reference={"dice": math.nan}), "cannot be stored as JSON: Out of range"),
     "not an object": (lambda d: d.clear() or d.update(format="VolumeCuttingAssessment", version=1, session=[]),
                       "session must be an object"),
 }

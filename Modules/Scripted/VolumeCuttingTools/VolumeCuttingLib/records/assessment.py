@@ -127,7 +127,7 @@ def check(document, source: str = "the assessment") -> CheckedAssessment:
         problems.append(f"metrics must be an object of name: number, got {type(metrics).__name__}")
     elif isinstance(metrics, dict):
         for name, value in metrics.items():
-            if not name or len(name) > MAX_NAME_LENGTH:
+            if not isinstance(name, str) or not name or len(name) > MAX_NAME_LENGTH:
                 problems.append(f"metric name {name!r} must have 1 to {MAX_NAME_LENGTH} characters")
             elif not _finite_number(value):
                 problems.append(f"metric {name} must be a finite number, got {value!r}")

@@ -241,7 +241,10 @@ class RecordStore:
             raise AssessmentError(f"{source} names no trainee (session.trainee is null): say whose session it is")
         if len(name) > assessment_format.MAX_NAME_LENGTH:
             raise AssessmentError(f"trainee name longer than {assessment_format.MAX_NAME_LENGTH} characters")
-        document = json.dumps(assessment, sort_keys=True, allow_nan=False)
+        try:
+            document = json.dumps(assessment, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError) as error:  # NaN or an object JSON cannot hold, in a part not checked field by field
+            raise AssessmentError(f"{source} cannot be stored as JSON: {error}") from None
         for _attempt in range(ADD_ATTEMPTS):
             try:
                 with OrmSession(self.engine, expire_on_commit=False) as db, db.begin():
@@ -281,6 +284,9 @@ class RecordStore:
                 continue
             except (OperationalError, DBAPIError) as error:
                 raise RecordsError(f"could not store trainee {name!r} in {self}: {_reason(error)}") from None
+        else:
+            raise RecordsError(f"could not store trainee {name!r} in {self}: {ADD_ATTEMPTS} attempts conflicted "
+                               "with other writers")
         return next(t for t in self.trainees() if t.name == name.strip())
 
     @staticmethod

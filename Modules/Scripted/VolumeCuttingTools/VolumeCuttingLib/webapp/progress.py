@@ -118,7 +118,8 @@ class ProgressPanel:
 
     def _store(self):
         if self._records is None:
-            self._records = database.open(self.records_url)
+            # A short connection timeout: the page waits for it.
+            self._records = database.open(self.records_url, connect_timeout_s=3)
         return self._records
 
     def refresh(self) -> None:
