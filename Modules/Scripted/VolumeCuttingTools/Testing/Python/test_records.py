@@ -9,12 +9,10 @@ loopback port). Assessments are made up here in the documented format.
 import hashlib
 import json
 import math
+import multiprocessing
 import socket
-import subprocess
-import sys
-import textwrap
+import traceback
 from itertools import count
-from pathlib import Path
 
 import pytest
 from alembic.autogenerate import compare_metadata
@@ -26,7 +24,6 @@ from VolumeCuttingLib.records import database
 from VolumeCuttingLib.records.assessment import AssessmentError
 from VolumeCuttingLib.records.schema import Base
 
-MODULE_DIR = Path(__file__).resolve().parents[2]
 DATABASE_NUMBERS = count(1)
 
 
@@ -176,43 +173,33 @@ def test_learning_curves_follow_time_not_the_order_of_adding(url):
             records.learning_curve("Carol", ["score"])
 
 
-WRITER = textwrap.dedent("""
-    import json, sys, time
-    from pathlib import Path
-    sys.path.insert(0, sys.argv[1])
-    from VolumeCuttingLib.records import database
-    documents = json.load(open(sys.argv[3]))
-    # Both writers imported: start together, so that they open the empty database and write at the same time.
-    ready = Path(sys.argv[4])
-    (ready / sys.argv[5]).touch()
-    deadline = time.monotonic() + 60
-    while len(list(ready.iterdir())) < 2 and time.monotonic() < deadline:
-        time.sleep(0.001)
-    created = 0
-    with database.open(sys.argv[2]) as records:
-        for document in documents:
-            created += records.add_assessment("Shared", document).created
-    print(created)
-""")
+def write_in_another_process(url, documents, barrier, results):
+    """A writer process: wait for the other one, open the (empty) database, add every document."""
+    try:
+        barrier.wait(60)  # start together, so that both migrate the empty database and write at the same time
+        with database.open(url) as records:
+            results.put(sum(records.add_assessment("Shared", document).created for document in documents))
+    except BaseException:
+        results.put(traceback.format_exc())
 
 
-def test_two_processes_writing_at_once_lose_nothing_and_store_each_recording_once(url, tmp_path):
+def test_two_processes_writing_at_once_lose_nothing_and_store_each_recording_once(url):
     # Both open the database while it is still empty (both migrate), then add 12 sessions each, 6 of them the same.
+    # Forked, not spawned: two real processes that need not import everything again (seconds on a busy machine).
+    context = multiprocessing.get_context("fork")
+    barrier, results = context.Barrier(2), context.Queue()
     common = [make_assessment(f"common{i}", f"2026-11-{i + 1:02d}T10:00:00Z", 10.0 * i) for i in range(6)]
     processes = []
-    ready = tmp_path / "ready"
-    ready.mkdir()
     for writer in ("one", "two"):
         own = [make_assessment(f"{writer}{i}", f"2026-11-{i + 10:02d}T10:00:00Z", 50.0 + i) for i in range(6)]
         documents = common + own if writer == "one" else own + common[::-1]
-        path = tmp_path / f"{writer}.json"
-        path.write_text(json.dumps(documents))
-        processes.append(subprocess.Popen([sys.executable, "-c", WRITER, str(MODULE_DIR), url, str(path), str(ready), writer],
-                                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True))
-    results = [process.communicate(timeout=120) for process in processes]
-    for process, (out, err) in zip(processes, results):
-        assert process.returncode == 0, err
-    assert sum(int(out) for out, _ in results) == 18  # each of the 18 recordings created by exactly one writer
+        processes.append(context.Process(target=write_in_another_process, args=(url, documents, barrier, results)))
+        processes[-1].start()
+    created = [results.get(timeout=120) for _ in processes]
+    for process in processes:
+        process.join(30)
+    assert all(isinstance(c, int) for c in created), "\n".join(c for c in created if isinstance(c, str))
+    assert sum(created) == 18  # each of the 18 recordings created by exactly one writer
     with database.open(url) as records:
         sessions = records.sessions("Shared")
         assert len(sessions) == 18 and len({s.recording_sha256 for s in sessions}) == 18
