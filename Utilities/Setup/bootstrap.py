@@ -4,7 +4,8 @@ Run by both README commands (through Utilities/vc). Each step checks first and o
 does what is missing:
 
 1. Debian bookworm packages (compiler, CMake, Ninja, hidapi, libusb, umockdev, Mesa EGL,
-   and Chromium, the browser the web application's tests drive);
+   Chromium, the browser the web application's tests drive, and the PostgreSQL server the
+   trainee-records tests start);
 2. the project virtual environment ``.venv`` with the exact wheels of
    ``requirements.lock`` and, without their declared dependencies, of
    ``requirements-nodeps.lock`` (hash-checked), downloaded once into the cache;
@@ -46,6 +47,8 @@ APT_PACKAGES = [
     "libegl1", "libegl-mesa0", "libgl1-mesa-dri",
     # The browser that Playwright drives in the web application's tests (no browser download).
     "chromium",
+    # The PostgreSQL server (15) that the trainee-records tests start on a temporary cluster.
+    "postgresql",
 ]
 
 

@@ -10,6 +10,8 @@ Subpackages (each imports only those listed above it, never one below):
     cutting: scripted drilling paths, recorded sessions and their replay, SoftCut planning.
     jobs: the main job (``python -m VolumeCuttingLib.jobs.mainjob``), its haptic and SoftCut
         parts, and the Slicer self-tests.
+    records: trainee records, the assessed sessions in SQLite or PostgreSQL, and learning curves
+        (``python -m VolumeCuttingLib.records``).
     webapp: the web application (``python -m VolumeCuttingLib.webapp``).
     benchmarks: the benchmark harness and one module per area
         (``python -m VolumeCuttingLib.benchmarks --area AREA``).

@@ -38,3 +38,17 @@ def browser():
         chromium = launch_chromium(playwright)
         yield chromium
         chromium.close()
+
+
+@pytest.fixture(scope="session")
+def postgres_server():
+    """A PostgreSQL server of Debian's package on a temporary cluster and a loopback port, one per test session."""
+    from VolumeCuttingLib.records import localserver
+
+    try:
+        server = localserver.TemporaryPostgres()
+    except localserver.PostgresUnavailable as error:
+        pytest.skip(str(error))
+    server.start()
+    yield server
+    server.stop()

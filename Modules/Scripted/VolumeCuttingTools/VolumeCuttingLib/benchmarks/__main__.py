@@ -29,6 +29,7 @@ AREAS = {
     "sliceview": ("sliceview", "sliceview"),
     "softcut": ("softcut", "softcut_area"),
     "webapp": ("webapp", "webapp"),
+    "records": ("records", "records"),
 }
 
 

@@ -45,7 +45,7 @@ from wslink.websocket import LinkProtocol
 from ..config import toolconfig
 from ..data import headct, owndata
 from ..jobs import softcutjob
-from . import rendering, views
+from . import progress, rendering, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)
 
@@ -88,6 +88,7 @@ class Options:
     drill_scale: float = 0.5
     refine_delay_s: float = 0.5
     work_dir: Path | None = None
+    records: str | None = None
 
     @property
     def max_upload_bytes(self) -> int:
@@ -108,6 +109,9 @@ def add_arguments(parser) -> None:
                        help="render scale of the 3D view while the camera moves (refined when the mouse stops)")
     group.add_argument("--drill-scale", type=float, default=Options.drill_scale, help="render scale of the 3D view while drilling")
     group.add_argument("--work-dir", type=Path, default=None, help="folder for uploads and exports (default: a temporary one)")
+    group.add_argument("--records", default=None, metavar="URL",
+                       help="trainee records for the Progress panel: SQLAlchemy URL or SQLite file "
+                            "(default: $VOLUMECUTTING_RECORDS or ~/.local/share/volumecutting/records.sqlite)")
 
 
 def options_from_arguments(args) -> Options:
@@ -123,7 +127,7 @@ def options_from_arguments(args) -> Options:
     source = "phantom" if args.phantom else "own" if args.ct is not None else "headct"
     return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
                    max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
-                   work_dir=args.work_dir)
+                   work_dir=args.work_dir, records=args.records)
 
 
 def path_allowed(path: Path, folders) -> bool:
@@ -209,6 +213,7 @@ class VolumeCuttingApp(TrameApp):
         self.server.add_protocol_to_configure(lambda protocol: protocol.registerLinkProtocol(ConnectionWatch(self)))
         self._register_views()
         self._initialize_state()
+        self.progress = progress.ProgressPanel(self.server, self.options.records)
         self._build_ui()
         self._connect_three_d_view()
 
@@ -874,6 +879,7 @@ class VolumeCuttingApp(TrameApp):
             self._drill_panel()
             self._softcut_panel()
             self._export_panel()
+            self.progress.build()
 
     def _data_panel(self) -> None:
         with v3.VExpansionPanel(value="data", title="Data"), v3.VExpansionPanelText():
