@@ -8,14 +8,16 @@ put them back, undo and redo take a stroke back and forth. Replaying on the
 labels rather than through the logic keeps the assessment Slicer-free and
 lets it know, at each pose, what material remains, which the visibility
 metric needs: the burr is hidden when the ray from the recorded camera to
-the side of the burr facing it crosses an opaque voxel that is still there.
+the side of the burr facing it crosses an opaque voxel of the operative field
+(the poses' box grown by the burr and 4 mm) that is still there.
 
 Distances are from the burr's surface to a structure's surface: the distance
 from the burr centre to the nearest surface-voxel centre of the structure,
 less half a voxel (where the voxelised surface lies) and the burr radius;
 negative inside. Each pose stands for the interval since the previous pose
 of its stroke (the first of a stroke for none): times within 1 and 2 mm,
-contact time, idle time and hidden time add those intervals up.
+contact time and hidden time add those intervals up; idle time is the
+session's time between strokes.
 
 Regions are the cuttable segments and, per protected structure, the bands of
 cuttable material 0-1, 1-2 and 2-4 mm from it.
@@ -183,7 +185,12 @@ def _camera_at(frames: np.ndarray, time: float):
 
 
 def _hidden(crop: Crop, present: np.ndarray, camera, center, radius) -> bool:
-    """Whether opaque material still there lies between the camera and the side of the burr facing it."""
+    """Whether opaque material still there lies between the camera and the side of the burr facing it.
+
+    Only the operative field (the crop) can hide the burr: what lies beyond
+    it in the scan, a head holder, the far side of the head, is not between
+    a surgeon's microscope and the field.
+    """
     scan = crop.scan
     toward = center - camera
     distance = float(np.linalg.norm(toward))
@@ -194,16 +201,7 @@ def _hidden(crop: Crop, present: np.ndarray, camera, center, radius) -> bool:
     step = 0.5 * float(scan.spacing.min())
     samples = camera + np.arange(0.0, stop, step)[:, None] * (toward / distance)
     ijk = np.rint(scan.ras_to_ijk(samples)).astype(int)
-    dims = np.array(scan.dimensions)
-    inside = np.all((ijk >= 0) & (ijk < dims), axis=1)
-    ijk = ijk[inside]
-    if len(ijk) == 0:
-        return False
-    in_crop = np.all((ijk >= crop.low) & (ijk < crop.high), axis=1)
-    outside = ijk[~in_crop]
-    if len(outside) and crop.opaque_table[scan.labels[outside[:, 2], outside[:, 1], outside[:, 0]]].any():
-        return True
-    local = ijk[in_crop] - crop.low
+    local = ijk[np.all((ijk >= crop.low) & (ijk < crop.high), axis=1)] - crop.low
     return bool(present[local[:, 2], local[:, 1], local[:, 0]].any())
 
 
@@ -331,6 +329,8 @@ class Assessment:
     reference_replay: Replay | None
     crop: Crop
     parts: dict
+    camera_direction: np.ndarray | None = None  # the first recorded frame's view direction, for the report's pictures
+    reference_camera_direction: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         return {"format": FORMAT, "version": VERSION, "session": self.session, "score": self.score,
@@ -382,7 +382,7 @@ def _safety(scan, replayed: Replay, recording: dict, metrics: dict) -> float:
     return float(np.mean(terms))
 
 
-def _efficiency(scan, replayed: Replay, recording: dict, metrics: dict, reference: Replay | None) -> float:
+def _efficiency(scan, replayed: Replay, recording: dict, metrics: dict, reference: Replay | None) -> float | None:
     duration = float(replayed.times[-1] - replayed.times[0])
     steps = np.linalg.norm(np.diff(replayed.positions, axis=0), axis=1)
     path_length = float(steps[~replayed.first_of_stroke[1:]].sum())
@@ -395,11 +395,12 @@ def _efficiency(scan, replayed: Replay, recording: dict, metrics: dict, referenc
     metrics["efficiency.drilling_time_s"] = drilling_time
     metrics["efficiency.removed_mm3"] = removed
     metrics["efficiency.removal_rate_mm3_s"] = removed / drilling_time if drilling_time > 0.0 else 0.0
-    metrics["efficiency.idle_time_s"] = duration - removing_time
+    metrics["efficiency.idle_time_s"] = duration - drilling_time
+    metrics["efficiency.time_removing_nothing_s"] = duration - removing_time
     metrics["efficiency.undo"] = replayed.undo
     metrics["efficiency.redo"] = replayed.redo
     if reference is None:
-        return removing_time / duration if duration > 0.0 else 1.0
+        return None  # efficiency is relative: without an expert's session it is reported, not scored
     reference_duration = float(reference.times[-1] - reference.times[0])
     reference_path = float(np.linalg.norm(np.diff(reference.positions, axis=0), axis=1)[~reference.first_of_stroke[1:]].sum())
     return float(np.mean([min(1.0, reference_duration / duration) if duration > 0.0 else 1.0,
@@ -440,6 +441,11 @@ def _final_product(crop: Crop, replayed: Replay, reference: Replay | None, metri
         metrics[f"final.under_mm3.{region}"] = float((b & ~a).sum()) * voxel
         metrics[f"final.dice.{region}"] = 2.0 * float((a & b).sum()) / float(a.sum() + b.sum()) if (a.sum() + b.sum()) else 1.0
     return metrics["final.dice"]
+
+
+def _view_direction(recording: dict | None):
+    frames = (recording or {}).get("camera", {}).get("frames", [])
+    return np.asarray(frames[0][4:7], dtype=float) - np.asarray(frames[0][1:4], dtype=float) if frames else None
 
 
 def assess(recording: dict, scan: scanlib.Scan | None = None, reference: dict | None = None,
@@ -489,4 +495,4 @@ def assess(recording: dict, scan: scanlib.Scan | None = None, reference: dict | 
                           "sha256": recordings.content_sha256(reference), "started": reference.get("started"),
                           "duration_s": round(float(expert.times[-1] - expert.times[0]), 6)}
     return Assessment(_session_info(recording, recording_path, scan, trainee), round(score, 3), metrics, reference_info,
-                      list(crop.regions), trainee, expert, crop, parts)
+                      list(crop.regions), trainee, expert, crop, parts, _view_direction(recording), _view_direction(reference))

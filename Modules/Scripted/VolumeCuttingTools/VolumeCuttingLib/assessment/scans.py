@@ -12,8 +12,8 @@ The head CT carries no anatomy segmentation: bone is thresholded as the
 product's bone segmentation does (cortical from 700 HU, trabecular from
 200 HU), and the structures at risk are tubes placed at fixed offsets from the
 right mastoid's lateral surface, deeper than the shipped mastoidectomy goes:
-a 2 mm facial nerve 5 mm beyond the saucer's floor and a 6 mm sigmoid sinus
-posterior to it. They are stand-ins for grading, not the patient's anatomy.
+a 3 mm facial canal about 4 mm beyond the saucer's floor and an 8 mm sigmoid
+sinus posterior to it (the CT's voxels are about 1 x 1 x 1.5 mm). They are stand-ins for grading, not the patient's anatomy.
 """
 
 from __future__ import annotations
@@ -166,8 +166,8 @@ HEAD_CT_TRABECULAR_HU = 200.0
 # Stand-in structures at risk, from the right mastoid's lateral surface (RAS mm offsets: depth along -x, posterior -y).
 HEAD_CT_STRUCTURES = {
     # name: (offset of the tube's centre line from the entry, its direction, radius, half length)
-    "FacialNerve": ((-19.0, -2.0, 0.0), (0.0, 0.0, 1.0), 1.0, 10.0),
-    "SigmoidSinus": ((-9.0, -17.0, 0.0), (0.0, 0.0, 1.0), 3.0, 12.0),
+    "FacialNerve": ((-19.0, -2.0, 0.0), (0.0, 0.0, 1.0), 1.5, 12.0),
+    "SigmoidSinus": ((-10.0, -18.0, 0.0), (0.0, 0.0, 1.0), 4.0, 15.0),
 }
 
 

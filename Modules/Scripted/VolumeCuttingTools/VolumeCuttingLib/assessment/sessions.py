@@ -7,8 +7,9 @@ seen from outside along the approach as ``mainjob.cavity_camera`` looks.
 
 The careless one is what graders fault: a 6 mm cutting burr at 20 mm/s
 plunging from the entry straight toward each structure at risk until it
-touches it, then undercutting sideways beneath the cortex where the camera,
-looking in along the approach, cannot see the burr.
+touches it, then undercutting sideways beneath the cortex, while the camera
+looks at the field from 60 degrees above the approach, never brought over
+the hole: the burr works where it cannot be seen.
 
     python -m VolumeCuttingLib.assessment.sessions --scan phantom|headct --out DIR
 """
@@ -30,6 +31,7 @@ CARELESS_SPEED_MM_S = 20.0
 CAMERA_RATE_HZ = 10.0
 CARELESS_BURR = {"name": "Cutting burr 6 mm", "burr_type": "Cutting", "radius_mm": 3.0}
 DIAMOND_3MM = {"name": "Diamond burr 3 mm", "burr_type": "Diamond", "radius_mm": 1.5}
+CARELESS_CAMERA_TILT_DEG = 60.0
 APPROACH = np.array([-1.0, 0.0, 0.0])  # into the bone, from the patient's right
 
 
@@ -42,21 +44,27 @@ def plan_for(scan: scanlib.Scan) -> drilling.MastoidectomyPlan:
     return drilling.MastoidectomyPlan(entry=scan.entry)
 
 
-def camera_frames(plan: drilling.MastoidectomyPlan, until_s: float, rate_hz: float = CAMERA_RATE_HZ) -> list:
-    """A still camera looking into the planned cavity along its approach (``mainjob.cavity_camera``), one frame per 1/rate s."""
+def camera_frames(plan: drilling.MastoidectomyPlan, until_s: float, rate_hz: float = CAMERA_RATE_HZ, tilt_deg: float = 0.0) -> list:
+    """A still camera looking into the planned cavity along its approach (``mainjob.cavity_camera``), one frame per 1/rate s.
+
+    ``tilt_deg`` swings it that far toward the top of the head: a view the
+    trainee never brought over the hole.
+    """
     into = np.asarray(plan.direction, dtype=float) / np.linalg.norm(plan.direction)
     center = np.asarray(plan.entry, dtype=float) + 0.5 * plan.depth * into
     distance = 0.5 * 6.0 * plan.surface_radius / np.tan(np.radians(15.0))
-    position = center - distance * into
+    tilt = np.radians(tilt_deg)
+    position = center + distance * (-np.cos(tilt) * into + np.sin(tilt) * np.array([0.0, 0.0, 1.0]))
     return [[t, *position, *center, 0.0, 0.0, 1.0, 30.0] for t in np.arange(0.0, until_s + 1.0 / rate_hz, 1.0 / rate_hz)]
 
 
-def _finish(recording: dict, plan, tools: dict, scan: scanlib.Scan, speed: float, trainee: str, pause_s: float) -> dict:
+def _finish(recording: dict, plan, tools: dict, scan: scanlib.Scan, speed: float, trainee: str, pause_s: float,
+            tilt_deg: float = 0.0) -> dict:
     timed = recordings.timed(recording, tools, speed, pause_s, scan=scan.descriptor(), trainee=trainee,
                              started="2026-11-27T09:00:00+00:00")
     last = timed["strokes"][-1]["times"][-1]
     timed["camera"] = {"fields": list(recordings.CAMERA_FIELDS),
-                       "frames": [[round(float(v), 6) for v in frame] for frame in camera_frames(plan, last)]}
+                       "frames": [[round(float(v), 6) for v in frame] for frame in camera_frames(plan, last, tilt_deg=tilt_deg)]}
     return timed
 
 
@@ -107,7 +115,7 @@ def careless(scan: scanlib.Scan, structures=None) -> dict:
                                                                                            depth + side * 10.0 * across + np.array([0, 0, 6.0]))[1:]})
     untimed = {"format": recordings.FORMAT, "version": 1, "frame": "RAS", "units": "mm", "strokes": strokes,
                "description": "A careless drilling: a 6 mm cutting burr plunging toward the structures at risk and undercutting the cortex."}
-    return _finish(untimed, plan, {"cutting": CARELESS_BURR}, scan, CARELESS_SPEED_MM_S, "careless", 0.2)
+    return _finish(untimed, plan, {"cutting": CARELESS_BURR}, scan, CARELESS_SPEED_MM_S, "careless", 0.2, CARELESS_CAMERA_TILT_DEG)
 
 
 def main(argv=None) -> int:
