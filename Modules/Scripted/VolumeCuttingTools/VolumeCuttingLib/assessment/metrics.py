@@ -156,25 +156,36 @@ def _poses(recording: dict):
             np.array(columns[4], dtype=bool), np.array(columns[5]), np.array(columns[6], dtype=bool), np.array(columns[7], dtype=bool))
 
 
+_OFFSETS = {}
+
+
+def _box_offsets(shape) -> np.ndarray:
+    """The (i, j, k) offsets of every voxel of a box of that shape, in the crop's flat order (k slowest), cached."""
+    offsets = _OFFSETS.get(shape)
+    if offsets is None:
+        k, j, i = np.indices(shape[::-1])
+        offsets = _OFFSETS[shape] = np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
+    return offsets
+
+
 def _capsule_voxels(crop: Crop, start, end, radius) -> np.ndarray:
     """Flat crop indices of voxels whose centres lie within ``radius`` of the segment start-end."""
     scan = crop.scan
-    points = np.array([start, end])
     reach = radius / scan.spacing.min() + 1.0
-    ijk = scan.ras_to_ijk(points) - crop.low
+    ijk = scan.ras_to_ijk(np.array([start, end])) - crop.low
     low = np.maximum(np.floor(ijk.min(axis=0) - reach).astype(int), 0)
     high = np.minimum(np.ceil(ijk.max(axis=0) + reach).astype(int) + 1, crop.high - crop.low)
     if np.any(high <= low):
         return np.zeros(0, dtype=np.int64)
-    axes = [np.arange(low[a], high[a]) for a in range(3)]
-    k, j, i = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
-    ijk_local = np.stack([i.ravel(), j.ravel(), k.ravel()], axis=1)
-    centers = scan.ijk_to_ras_points(ijk_local + crop.low)
-    axis = end - start
+    local = _box_offsets(tuple(int(n) for n in high - low)) + low
+    # Offsets from the segment's start in RAS: one matrix product, the translation cancels.
+    relative = (local - (scan.ras_to_ijk(start) - crop.low)) @ scan.ijk_to_ras[:3, :3].T
+    axis = np.asarray(end, dtype=float) - start
     length2 = float(axis @ axis)
-    t = np.clip((centers - start) @ axis / length2, 0.0, 1.0) if length2 > 0.0 else np.zeros(len(centers))
-    inside = np.einsum("ij,ij->i", centers - start - t[:, None] * axis, centers - start - t[:, None] * axis) <= radius * radius
-    chosen = ijk_local[inside]
+    if length2 > 0.0:
+        t = np.clip(relative @ axis / length2, 0.0, 1.0)
+        relative = relative - t[:, None] * axis
+    chosen = local[np.einsum("ij,ij->i", relative, relative) <= radius * radius]
     shape = crop.labels.shape
     return (chosen[:, 2] * shape[1] + chosen[:, 1]) * shape[2] + chosen[:, 0]
 
@@ -307,7 +318,7 @@ def structure_distances(scan: scanlib.Scan, structure: str, points: np.ndarray) 
 
 def prepare(recording: dict, path: str = "recording") -> dict:
     """A recording ready to grade: checked, and timed at the stated nominal speed when it is a version 1 recording."""
-    recordings.check(recording, path)
+    recordings.check(recording, path, require_checksum=False)
     if recording.get("version", 1) >= 2:
         return recording
     if "tools" not in recording:
