@@ -107,6 +107,19 @@ def test_distances_and_times_near_the_nerve(scene):
     assert m[f"final.removed_mm3.{metrics.band_name('Nerve', (0.0, 1.0))}"] == 0.0
 
 
+def test_the_largest_force_near_the_nerve(scene):
+    # The same approach with a force per pose (N), falling as the burr nears: within 2 mm are the last three poses.
+    heights = [8.0, 9.0, 10.0, 10.7, 11.1, 11.8]
+    recording = session(scene, [("burr", [[10.0, 10.0, z] for z in heights])], speed=1.0)
+    recording["strokes"][0]["forces"] = [6.0, 5.0, 4.0, 3.0, 2.0, 1.0]
+    recording["sha256"] = recordings.content_sha256(recording)
+    m = metrics.assess(recording, scene).metrics
+    assert m["safety.max_force_within_2mm_n.Nerve"] == 3.0
+    assert m["safety.max_force_within_1mm_n.Nerve"] == 1.0
+    # Without recorded forces there is no force metric rather than a zero.
+    assert not any("force" in key for key in metrics.assess(session(scene, [("burr", [[10.0, 10.0, 8.0]])]), scene).metrics)
+
+
 def test_bands_hold_the_removed_bone_at_their_distances(scene):
     # A stroke along the box's top under the nerve; count by hand which removed voxel centres lie in each band.
     graded = metrics.assess(session(scene, [("burr", line([4, 10, 11], [16, 10, 11], 25))]), scene)
@@ -223,6 +236,7 @@ def test_version_2_round_trip_and_version_1_still_read(scene, tmp_path):
     assert recordings.load(path) == recording
     shipped = recordings.load(recordings.head_ct_mastoidectomy_path())
     assert shipped["version"] == 1 and len(shipped["strokes"]) == 86
+    assert recordings._edits_before(shipped) == [[] for _ in range(87)]  # untimed: nothing to undo, replays as before
 
 
 @pytest.mark.parametrize("damage, words", [

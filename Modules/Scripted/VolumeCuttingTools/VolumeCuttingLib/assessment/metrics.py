@@ -16,6 +16,7 @@ from the burr centre to the nearest surface-voxel centre of the structure,
 less half a voxel (where the voxelised surface lies) and the burr radius;
 negative inside. Each pose stands for the interval since the previous pose
 of its stroke (the first of a stroke for none): times within 1 and 2 mm,
+the largest force there (where a device recorded forces),
 contact time and hidden time add those intervals up; idle time is the
 session's time between strokes.
 
@@ -75,6 +76,7 @@ class Replay:
     hidden: np.ndarray | None  # (N,) the burr was hidden from the camera (None: no camera recorded)
     region_series: np.ndarray  # (N, regions) removed volume per region after each pose, mm3
     final_removed: np.ndarray  # bool, crop shaped
+    forces: np.ndarray | None = None  # (N,) force on the tool, N, where recorded (NaN elsewhere); None: none recorded
     distances: dict = field(default_factory=dict)  # structure -> (N,) burr surface to structure surface, mm
     undo: int = 0
     redo: int = 0
@@ -289,6 +291,9 @@ def replay(recording: dict, crop: Crop) -> Replay:
         series[-1] = region_totals
     result = Replay(positions, times, intervals, radii, large, stroke_of, first, cutting, removed_voxels, hidden, series,
                     removed.reshape(crop.labels.shape), undo=counts["undo"], redo=counts["redo"])
+    forces = [np.asarray(stroke["forces"], dtype=float) if "forces" in stroke else np.full(len(stroke["positions"]), np.nan)
+              for stroke in recording["strokes"]]
+    result.forces = np.concatenate(forces) if any("forces" in stroke for stroke in recording["strokes"]) else None
     result.distances = {structure: structure_distances(scan, structure, positions) - radii for structure in scan.protected}
     return result
 
@@ -374,6 +379,10 @@ def _safety(scan, replayed: Replay, recording: dict, metrics: dict) -> float:
         for near in NEAR_MM:
             metrics[f"safety.time_within_{near:g}mm_s.{structure}"] = float(intervals[(distance < near) & drilling].sum())
         near_time += metrics[f"safety.time_within_1mm_s.{structure}"]
+        if replayed.forces is not None:
+            for near in NEAR_MM:
+                pressed = replayed.forces[(distance < near) & drilling & np.isfinite(replayed.forces)]
+                metrics[f"safety.max_force_within_{near:g}mm_n.{structure}"] = float(pressed.max()) if len(pressed) else 0.0
     nearest = np.min(np.stack(list(replayed.distances.values())), axis=0) if replayed.distances else np.full(len(intervals), np.inf)
     large_near = replayed.large & drilling & (nearest < NEAR_MM[1])
     metrics["safety.contacts"] = total_contacts

@@ -13,8 +13,9 @@ Version 2 makes a recording complete enough to grade the session
 to rebuild it and its voxel grid), the tools (burr type and radius, since a
 large cutting burr near a nerve is a fault of its own), a time per pose, the
 camera of every rendered frame (what the trainee could see), events (drill
-on/off, tool changes, undo/redo, contacts) and the removed volume per segment
-over time; and a sha256 of its content, checked on reading, so a truncated or
+on/off, tool changes, undo/redo, contacts), the force on the tool per pose
+where a haptic device measured one, and the removed volume per segment over
+time; and a sha256 of its content, checked on reading, so a truncated or
 edited file is refused rather than graded. Version 1 files are still read.
 
     python -m VolumeCuttingLib.cutting.recording --head-ct OUT.json   # record the shipped mastoidectomy
@@ -189,6 +190,8 @@ def check(recording, path="recording", require_checksum=True) -> None:
             if np.any(np.diff(times) < 0.0) or times[0] < previous_time:
                 raise RecordingError(f"{where}: its times go backwards")
             previous_time = times[-1]
+            if "forces" in stroke and not _finite_list(stroke["forces"], len(positions)):
+                raise RecordingError(f"{where}: 'forces' must be one finite force (N) per position")
     if version >= 2:
         for index, event in enumerate(recording.get("events", [])):
             if not isinstance(event, dict) or event.get("type") not in EVENT_TYPES or not _finite_list([event.get("t")], 1):
@@ -285,9 +288,14 @@ class SessionRecorder:
         self._stroke = {"tool": tool, "action": action, "rotation": [float(v) for v in np.asarray(rotation, dtype=float).ravel()],
                         "positions": [], "times": []}
 
-    def pose(self, position) -> None:
+    def pose(self, position, force_n: float | None = None) -> None:
+        """A pose of the stroke; ``force_n`` the magnitude of the force on the tool (N), where a device measures it."""
         self._stroke["positions"].append([float(v) for v in position])
         self._stroke["times"].append(self.now())
+        if force_n is not None:
+            self._stroke.setdefault("forces", [0.0] * (len(self._stroke["positions"]) - 1)).append(float(force_n))
+        elif "forces" in self._stroke:
+            self._stroke["forces"].append(0.0)
 
     def end_stroke(self) -> None:
         self.event("drill_off")
