@@ -57,43 +57,57 @@ def distance_plot(assessment) -> str:
     axes.set_title("Distance from the burr to each structure at risk (lines at 1 and 2 mm; below 0: contact)")
     axes.set_ylim(min(-1.0, min((d.min() for d in replayed.distances.values()), default=0.0) - 0.5), NEAR_PLOT_MM)
     if shown:
-        axes.legend(fontsize=8, ncol=2)
+        axes.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return _figure_png(figure)
 
 
 def removal_plot(assessment) -> str:
+    """Removed volume per segment over time, and on their own scale the bands near each structure at risk."""
     plt = _pyplot()
     replayed = assessment.trainee
-    figure, axes = plt.subplots(figsize=(8, 3.6))
+    figure, (segments, bands) = plt.subplots(1, 2, figsize=(11, 3.8))
     time = replayed.times - replayed.times[0]
     for index, region in enumerate(assessment.regions):
         curve = replayed.region_series[:, index]
         if curve.max() > 0.0:
-            axes.plot(time, curve, lw=1.4 if "_band_" not in region else 0.9, ls="-" if "_band_" not in region else "--", label=region)
-    axes.set_xlabel("time (s)")
-    axes.set_ylabel("removed (mm³)")
-    axes.set_title("Removed volume per region over time (dashed: bands around structures at risk)")
-    axes.legend(fontsize=7, ncol=2)
+            (bands if "_band_" in region else segments).plot(time, curve, lw=1.2, label=region.replace("_band_", " "))
+    for axes, title in ((segments, "Segments"), (bands, "Bands around the structures at risk")):
+        axes.set_xlabel("time (s)")
+        axes.set_ylabel("removed (mm³)")
+        axes.set_title(title, fontsize=10)
+        if axes.lines:
+            axes.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        else:
+            axes.text(0.5, 0.5, "nothing removed here", ha="center", va="center", transform=axes.transAxes)
+    figure.suptitle("Removed volume per region over time")
+    figure.tight_layout()
     return _figure_png(figure)
 
 
 def region_bars(assessment) -> str | None:
+    """Removed volume per region, this session against the reference: segments, and on their own scale the bands near structures at risk."""
     if assessment.reference_replay is None:
         return None
     plt = _pyplot()
-    regions = [r for i, r in enumerate(assessment.regions)
-               if assessment.metrics.get(f"final.removed_mm3.{r}", 0) or assessment.metrics.get(f"final.reference_removed_mm3.{r}", 0)]
-    trainee = [assessment.metrics[f"final.removed_mm3.{r}"] for r in regions]
-    reference = [assessment.metrics[f"final.reference_removed_mm3.{r}"] for r in regions]
-    figure, axes = plt.subplots(figsize=(8, 0.5 + 0.32 * max(len(regions), 1)))
-    rows = np.arange(len(regions))
-    axes.barh(rows - 0.2, trainee, height=0.4, color=COLORS["removed"], label="this session")
-    axes.barh(rows + 0.2, reference, height=0.4, color=COLORS["reference"], label="reference")
-    axes.set_yticks(rows, regions, fontsize=8)
-    axes.invert_yaxis()
-    axes.set_xlabel("removed (mm³)")
-    axes.set_title(f"Removed volume per region against the reference (Dice {assessment.metrics['final.dice']:.2f})")
-    axes.legend(fontsize=8)
+    metrics = assessment.metrics
+    regions = [r for r in assessment.regions
+               if metrics.get(f"final.removed_mm3.{r}", 0) or metrics.get(f"final.reference_removed_mm3.{r}", 0)]
+    groups = [[r for r in regions if "_band_" not in r], [r for r in regions if "_band_" in r]]
+    groups = [group for group in groups if group]
+    if not groups:
+        return None
+    figure, panels = plt.subplots(1, len(groups), figsize=(10, 0.8 + 0.32 * max(len(g) for g in groups)), squeeze=False)
+    for panel, group, title in zip(panels[0], groups, ("Segments", "Bands around the structures at risk")):
+        rows = np.arange(len(group))
+        panel.barh(rows - 0.2, [metrics[f"final.removed_mm3.{r}"] for r in group], height=0.4, color=COLORS["removed"], label="this session")
+        panel.barh(rows + 0.2, [metrics[f"final.reference_removed_mm3.{r}"] for r in group], height=0.4, color=COLORS["reference"], label="reference")
+        panel.set_yticks(rows, [r.replace("_band_", " ") for r in group], fontsize=8)
+        panel.invert_yaxis()
+        panel.set_xlabel("removed (mm³)")
+        panel.set_title(title, fontsize=10)
+    panels[0][0].legend(fontsize=8)
+    figure.suptitle(f"Removed volume per region against the reference (Dice {metrics['final.dice']:.2f})")
+    figure.tight_layout()
     return _figure_png(figure)
 
 
