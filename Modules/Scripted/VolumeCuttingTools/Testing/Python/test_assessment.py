@@ -236,7 +236,7 @@ def test_version_2_round_trip_and_version_1_still_read(scene, tmp_path):
     assert recordings.load(path) == recording
     shipped = recordings.load(recordings.head_ct_mastoidectomy_path())
     assert shipped["version"] == 1 and len(shipped["strokes"]) == 86
-    assert recordings._edits_before(shipped) == [[] for _ in range(87)]  # untimed: nothing to undo, replays as before
+    assert recordings.edits_before_strokes(shipped) == [[] for _ in range(87)]  # untimed: nothing to undo, replays as before
 
 
 @pytest.mark.parametrize("damage, words", [

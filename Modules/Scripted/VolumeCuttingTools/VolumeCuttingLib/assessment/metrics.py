@@ -218,11 +218,6 @@ def _hidden(crop: Crop, present: np.ndarray, camera, center, radius) -> bool:
     return bool(present[local[:, 2], local[:, 1], local[:, 0]].any())
 
 
-def _edits(recording: dict):
-    """Per stroke: the undo/redo events just before it; and those after the last stroke."""
-    return recordings._edits_before(recording)
-
-
 def replay(recording: dict, crop: Crop) -> Replay:
     """Replay a (timed) recording on the crop's labels; see the module docstring."""
     positions, times, intervals, radii, large, stroke_of, first, cutting = _poses(recording)
@@ -259,7 +254,7 @@ def replay(recording: dict, crop: Crop) -> Replay:
         target.append((took, gave))
         counts[kind] += 1
 
-    edits = _edits(recording)
+    edits = recordings.edits_before_strokes(recording)
     stroke_took, stroke_gave = [], []
     for n in range(len(positions)):
         stroke = stroke_of[n]

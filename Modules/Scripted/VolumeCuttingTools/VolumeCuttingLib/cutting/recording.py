@@ -320,7 +320,7 @@ def head_ct_mastoidectomy_path() -> Path:
     return find_resource("Sessions", HEAD_CT_MASTOIDECTOMY)
 
 
-def _edits_before(recording: dict):
+def edits_before_strokes(recording: dict):
     """Undo/redo events grouped by the stroke they precede (len(strokes): after the last), in time order."""
     strokes = recording["strokes"]
     starts = [stroke["times"][0] if "times" in stroke else None for stroke in strokes]
@@ -349,7 +349,7 @@ def replay(logic, cut_node, recording: dict, tool_nodes: dict, recorder: Session
     matrix = vtk.vtkMatrix4x4()
     times = []
     refused = 0
-    edits = _edits_before(recording)
+    edits = edits_before_strokes(recording)
     contact_table = logic.GetContactTableNode(cut_node) if recorder is not None else None
     contacts_seen = contact_table.GetNumberOfRows() if contact_table is not None else 0
     segmentation = cut_node.GetSegmentationNode().GetSegmentation() if recorder is not None and cut_node.GetSegmentationNode() else None
