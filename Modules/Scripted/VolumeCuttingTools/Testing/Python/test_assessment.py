@@ -351,3 +351,28 @@ def test_the_command_line_runs_as_vc_assess(scene, tmp_path):
     result = subprocess.run([sys.executable, "-m", "VolumeCuttingLib.assessment", str(broken), "--out", str(tmp_path / "o")],
                             capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2])
     assert result.returncode == 2 and str(broken) in result.stderr and not (tmp_path / "o").exists()
+
+
+def test_poses_outside_the_scan_are_refused(scene):
+    with pytest.raises(metrics.AssessmentError, match="outside the scan"):
+        metrics.assess(session(scene, [("burr", [[500.0, 500.0, 500.0], [510.0, 500.0, 500.0]])]), scene)
+
+
+@pytest.mark.realdata
+def test_a_version_1_recording_is_graded_given_its_scan_and_tools(tmp_path, capsys):
+    from VolumeCuttingLib.data import headct
+
+    try:
+        headct.fetch()
+    except headct.HeadCTUnavailableError as error:
+        pytest.skip(f"the head CT cannot be obtained: {error}")
+    shipped = str(recordings.head_ct_mastoidectomy_path())
+    # Without its tools it cannot be graded, and says so.
+    assert cli.main([shipped, "--scan", "headct", "--out", str(tmp_path / "no")]) == 2
+    assert "does not say what its tools are" in capsys.readouterr().err and not (tmp_path / "no").exists()
+    out = tmp_path / "v1"
+    assert cli.main([shipped, "--scan", "headct", "--tool", "cutting=Cutting:5", "--tool", "diamond=Diamond:3", "--out", str(out)]) == 0
+    document = json.loads((out / "assessment.json").read_text())
+    # Timed at the nominal 5 mm/s: its 86 strokes; no camera was recorded, so no visibility part.
+    assert document["metrics"]["efficiency.strokes"] == 86 and "visibility.hidden_removed_mm3" not in document["metrics"]
+    assert document["metrics"]["safety.contacts"] == 0
