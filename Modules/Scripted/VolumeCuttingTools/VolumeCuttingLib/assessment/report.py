@@ -96,7 +96,7 @@ def region_bars(assessment) -> str | None:
     groups = [group for group in groups if group]
     if not groups:
         return None
-    figure, panels = plt.subplots(1, len(groups), figsize=(10, 0.8 + 0.32 * max(len(g) for g in groups)), squeeze=False)
+    figure, panels = plt.subplots(1, len(groups), figsize=(10, max(2.8, 1.2 + 0.32 * max(len(g) for g in groups))), squeeze=False)
     for panel, group, title in zip(panels[0], groups, ("Segments", "Bands around the structures at risk")):
         rows = np.arange(len(group))
         panel.barh(rows - 0.2, [metrics[f"final.removed_mm3.{r}"] for r in group], height=0.4, color=COLORS["removed"], label="this session")
