@@ -120,6 +120,31 @@ def test_the_largest_force_near_the_nerve(scene):
     assert not any("force" in key for key in metrics.assess(session(scene, [("burr", [[10.0, 10.0, 8.0]])]), scene).metrics)
 
 
+def test_a_haptic_session_tick_by_tick(scene):
+    # At 1 kHz: 10 ticks with the drill off, 20 on rising toward the nerve, 5 off, 10 on; forces in N along -z.
+    rate = 1000.0
+    heights = np.concatenate([np.full(10, 8.0), np.linspace(8.0, 11.8, 20), np.full(5, 11.8), np.linspace(11.8, 9.0, 10)])
+    proxies = np.stack([np.full(45, 10.0), np.full(45, 10.0), heights], axis=1)
+    forces = np.zeros((45, 3))
+    forces[:, 2] = -np.linspace(0.5, 5.0, 45)
+    drilling = np.r_[np.zeros(10), np.ones(20), np.zeros(5), np.ones(10)].astype(bool)
+    recording = recordings.from_haptic_ticks(proxies, forces, drilling, rate, "burr", {"burr_type": "Diamond", "radius_mm": 1.5},
+                                             np.eye(3), scan=scene.descriptor())
+    recording["sha256"] = recordings.content_sha256(recording)
+    recordings.check(recording)
+    assert [len(s["positions"]) for s in recording["strokes"]] == [20, 10]
+    assert recording["strokes"][1]["times"][0] == pytest.approx(35 / rate)
+    m = metrics.assess(recording, scene).metrics
+    assert m["efficiency.strokes"] == 2 and m["efficiency.idle_time_s"] == pytest.approx(6 / rate)  # the drill off from tick 29 to 35
+    assert m["efficiency.path_length_mm"] == pytest.approx(3.8 + 2.8)
+    # Within 2 mm of the nerve (burr centre above 13.9 - 1.5 - 2 = 10.4 mm): the largest force sent there.
+    distance = 13.9 - 1.5 - heights
+    near = drilling & (distance < 2.0 - HALF_VOXEL)
+    maybe = drilling & (distance < 2.0 + HALF_VOXEL)
+    magnitudes = np.linalg.norm(forces, axis=1)
+    assert magnitudes[near].max() <= m["safety.max_force_within_2mm_n.Nerve"] <= magnitudes[maybe].max()
+
+
 def test_bands_hold_the_removed_bone_at_their_distances(scene):
     # A stroke along the box's top under the nerve; count by hand which removed voxel centres lie in each band.
     graded = metrics.assess(session(scene, [("burr", line([4, 10, 11], [16, 10, 11], 25))]), scene)

@@ -248,6 +248,39 @@ def timed(recording: dict, tools: dict, speed_mm_s: float = 5.0, pause_s: float 
     return result
 
 
+def from_haptic_ticks(proxies, forces, drilling, rate_hz: float, tool_key: str, tool: dict, rotation,
+                      scan: dict | None = None, description: str = "", started: str | None = None) -> dict:
+    """A version 2 recording of a haptic session, tick by tick (``vtkHapticRecorder``: proxy, force, drilling).
+
+    Each run of ticks with the drill on is a stroke at the device's rate:
+    positions are the proxy's (where the tool is held on the bone, RAS mm),
+    times the tick index over ``rate_hz``, forces the magnitude of the force
+    sent (N). Ticks with the drill off move no stroke; their time is idle.
+    """
+    proxies = np.asarray(proxies, dtype=float).reshape(-1, 3)
+    forces = np.asarray(forces, dtype=float)
+    forces = np.linalg.norm(forces, axis=1) if forces.ndim == 2 else forces.ravel()  # vectors or magnitudes
+    drilling = np.asarray(drilling, dtype=bool).ravel()
+    if not (len(proxies) == len(forces) == len(drilling)):
+        raise RecordingError("the haptic ticks' proxies, forces and drilling flags differ in number")
+    if rate_hz <= 0.0:
+        raise RecordingError("the haptic rate must be positive")
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], drilling.astype(np.int8), [0]])))
+    strokes, events = [], [{"t": 0.0, "type": "tool_change", "tool": tool_key}]
+    rotation = [float(v) for v in np.asarray(rotation, dtype=float).ravel()]
+    for first, stop in zip(edges[0::2], edges[1::2]):
+        times = np.arange(first, stop) / rate_hz
+        events += [{"t": float(times[0]), "type": "drill_on"}, {"t": float(times[-1]), "type": "drill_off"}]
+        strokes.append({"tool": tool_key, "action": "cut", "rotation": rotation, "positions": proxies[first:stop].tolist(),
+                        "times": times.tolist(), "forces": forces[first:stop].tolist()})
+    recording = {"format": FORMAT, "version": VERSION, "description": description, "frame": "RAS", "units": "mm",
+                 "started": started or datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                 "trainee": None, "tools": {tool_key: tool}, "strokes": strokes, "events": events}
+    if scan is not None:
+        recording["scan"] = scan
+    return recording
+
+
 class SessionRecorder:
     """Records a live session as a version 2 recording: strokes with a time per pose, events, camera frames, removed volumes.
 

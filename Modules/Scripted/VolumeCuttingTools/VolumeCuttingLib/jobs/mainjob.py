@@ -300,7 +300,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     # Then a session through the haptic path, beside the cavity: what it cuts
     # adds to the recorded mastoidectomy's volume in the tables that follow.
     with timer.measure("haptics_s"):
-        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
+        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render,
+                                 scan=scan_descriptor(volume, use_phantom, seed, own_data))
     removed_per_segment = by_segment_name(roles, {
         segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
         for segment_id in roles.GetSegmentIDs()
