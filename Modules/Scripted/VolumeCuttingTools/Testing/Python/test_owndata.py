@@ -548,8 +548,14 @@ def test_main_job_on_an_own_ct(tmp_path):
     cortical = summary["drilling"]["removed_volume_per_segment"]["Cortical bone"]
     assert cortical["segment_id"] == "CorticalBone" and cortical["removed_volume_mm3"] > 50.0
     assert summary["drilling"]["refused_poses"] == 0
-    for name in ("3d.png", "scene.mrb", "removed.stl"):
+    for name in ("3d.png", "scene.mrb", "removed.stl", "session.json"):
         assert (out / name).is_file()
+    # The drilling is recorded on the user's grid; the assessment rebuilds only the shipped scans, so it is not graded.
+    from VolumeCuttingLib.cutting import recording
+
+    session = recording.load(out / "session.json")
+    assert session["scan"]["name"] == "own" and session["scan"]["grid"]["dimensions"] == [48, 40, 32]
+    assert summary["assessment"]["score"] is None
 
 
 @pytest.mark.parametrize("arguments, named", [

@@ -113,7 +113,7 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
     return recorder.GetNumberOfTicks()
 
 
-def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True) -> dict:
+def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
@@ -122,6 +122,9 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     ``prepare_shield_ahead`` False leaves the shield of protected structures
     to be built by the haptic thread where it first reaches it (the
     comparison for the loop's preparer, ``vtkHapticLoop.SetPrepareShieldAhead``).
+    The replayed ticks are also saved as a complete recording
+    (``haptic_session.json``, ``recording.from_haptic_ticks``) on ``scan``
+    (the scan descriptor a recording names), for grading.
     """
     logic = application.volume_cutting_logic
     scene = application.scene
@@ -198,6 +201,11 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     proxies = np.array(proxies)
     # How deep the burr's centre went past the surface it started from.
     deepest = float(np.max((proxies - surface) @ direction)) if len(proxies) else 0.0
+    parameters = toolconfig.from_tool_node(tool)
+    complete = None if not drilling.any() else recording.save(recording.from_haptic_ticks(
+        proxies, magnitudes, drilling, RATE_HZ, "haptic", {"name": tool.GetName(), "burr_type": parameters.burr_type,
+                                                            "radius_mm": parameters.diameter / 2.0},
+        rotation, scan=scan, description="The main job's haptic session, tick by tick"), out_dir / "haptic_session.json")
     tool_pose = vtk.vtkMatrix4x4()
     tool.GetParentTransformNode().GetMatrixTransformToWorld(tool_pose)
     return {
@@ -207,6 +215,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "tool": tool.GetName() + (" (created)" if created else ""),
         "recording": str(recording_path),
         "replay_recording": str(out_dir / "haptic_replay.vchr"),
+        "complete_recording": str(complete) if complete else None,
         "device": replay.GetCapabilities().GetModelName() or "replay",
         "ticks_recorded": ticks,
         "ticks_run": int(loop.GetNumberOfTicks()),

@@ -30,6 +30,8 @@ import numpy as np
 import slicer
 
 from . import hapticsjob, selftests, softcutjob
+from ..assessment import metrics as assessment_metrics
+from ..assessment import report as assessment_report
 from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
@@ -39,6 +41,8 @@ from ..scene.nodes import array_from_volume_node, by_segment_name, segment_displ
 PHANTOM_CUTTABLE_SEGMENTS = phantom.CUTTABLE_SEGMENTS
 PHANTOM_BONE_SEGMENTS = phantom.BONE_SEGMENTS
 PHANTOM_PROTECTED_SEGMENTS = phantom.PROTECTED_SEGMENTS
+
+PHANTOM_DIMENSIONS, PHANTOM_SPACING = (128, 128, 96), (0.4, 0.4, 0.5)
 
 # On the user's own CT: a short path into the cuttable bone with a 3.5 mm burr.
 OWN_DATA_PLAN = {"surface_radius": 4.0, "depth": 4.0, "burr_radius": 1.75}
@@ -87,7 +91,7 @@ def load_anatomy(application: HeadlessSlicer, use_phantom: bool, seed: int, own_
         return volume, segmentation, f"user CT {own_data.ct} {dims[0]}x{dims[1]}x{dims[2]} at " + \
             "x".join(f"{s:.3f}" for s in spacing) + " mm"
     if use_phantom:
-        generated = phantom.generate_phantom(dimensions=(128, 128, 96), spacing=(0.4, 0.4, 0.5), seed=seed)
+        generated = phantom.generate_phantom(dimensions=PHANTOM_DIMENSIONS, spacing=PHANTOM_SPACING, seed=seed)
         volume, segmentation = phantom.create_phantom_nodes(application.scene, generated)
         return volume, segmentation, "procedural temporal-bone phantom 128x128x96 at 0.4x0.4x0.5 mm"
     volume = headct.load_volume_node(application.scene, name="HeadCT")
@@ -165,6 +169,18 @@ def removed_region_view(removed_fraction_node):
     center = np.array([(low[0] + high[0]) / 2.0, (low[1] + high[1]) / 2.0, centroid[2]])
     field = max(SLICE_VIEW_MINIMUM_FIELD_MM, 2.5 * float(np.max(high - low)))
     return center, field
+
+
+def scan_descriptor(volume, use_phantom: bool, seed: int, own_data: OwnData | None) -> dict:
+    """What a recording says of the scan it was drilled on: the name the assessment rebuilds it by, and its grid."""
+    ijk_to_ras = volume_node_ijk_to_ras(volume)
+    grid = {"dimensions": list(volume.GetImageData().GetDimensions()), "ijk_to_ras": [round(float(v), 6) for v in ijk_to_ras.ravel()]}
+    if own_data is not None:
+        return {"name": "own", "parameters": {"ct": str(own_data.ct)}, "grid": grid}
+    if use_phantom:
+        return {"name": "phantom", "parameters": {"dimensions": list(PHANTOM_DIMENSIONS), "spacing": list(PHANTOM_SPACING), "seed": seed},
+                "grid": grid}
+    return {"name": "headct", "parameters": {}, "grid": grid}
 
 
 def cavity_camera(view, plan):
@@ -261,8 +277,17 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     else:
         session = recording.load(recording.head_ct_mastoidectomy_path())
     volume_table = logic.GetRemovedVolumeTableNode(cut_node)
+    # The drilling is recorded as a live session is (session.json): poses with
+    # their times, the camera it was seen from, contacts and removed volumes.
+    recorder = recording.SessionRecorder(
+        {key: {"name": tool.GetName(), "burr_type": toolconfig.from_tool_node(tool).burr_type,
+               "radius_mm": toolconfig.from_tool_node(tool).diameter / 2.0} for key, tool in tools.items()},
+        scan=scan_descriptor(volume, use_phantom, seed, own_data), description=f"The main job's mastoidectomy on the {description}")
+    camera = view.renderer.GetActiveCamera()
+    recorder.camera(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle())
     with timer.measure("drilling_s"):
-        drilled = recording.replay(logic, cut_node, session, tools)
+        drilled = recording.replay(logic, cut_node, session, tools, recorder=recorder)
+    session_path = recording.save(recorder.recording, out_dir / "session.json")
     drilled["tool_presets"] = {key: tool.GetName() for key, tool in tools.items()}
     contact_table = logic.GetContactTableNode(cut_node)
     drilled["contact_events"] = contact_table.GetNumberOfRows()
@@ -275,7 +300,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     # Then a session through the haptic path, beside the cavity: what it cuts
     # adds to the recorded mastoidectomy's volume in the tables that follow.
     with timer.measure("haptics_s"):
-        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render)
+        haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render,
+                                 scan=scan_descriptor(volume, use_phantom, seed, own_data))
     removed_per_segment = by_segment_name(roles, {
         segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
         for segment_id in roles.GetSegmentIDs()
@@ -411,6 +437,16 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         "image_slice_view": str(slice_path),
         "timings": timer.seconds,
     }
+    # The recorded session graded (vc assess): on the shipped scans, which the assessment rebuilds.
+    if own_data is None:
+        with timer.measure("assessment_s"):
+            graded = assessment_metrics.assess(recording.load(session_path), recording_path=session_path)
+            written = assessment_report.write(graded, out_dir / "assessment")
+        summary["assessment"] = {"session": str(session_path), "score": graded.score, "report": str(written["html"]),
+                                 "metrics": str(written["json"])}
+    else:
+        summary["assessment"] = {"session": str(session_path), "score": None,
+                                 "report": "not graded: the assessment rebuilds only the shipped scans"}
     # Soft-tissue resection planning (SoftCut) on the head CT, in its own scene.
     summary["softcut"] = softcutjob.run(out_dir, size=size, head_ct=not use_phantom and own_data is None)
     if own_data is not None:
