@@ -179,6 +179,8 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
   vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
   const std::vector<std::string> shieldedIds = GetShieldedSegmentIDs(cutNode);
   vtkSlicerVolumeCuttingSegmentLayers* layers = this->GetSegmentLayers(cutNode);
+  // The wall a tool leaves against a structure is the surface drawn for it.
+  field->GetProtection()->SetSurfaceSmoothing(cutNode->GetLabelSmoothing());
   std::ostringstream source;
   source << field;
   if (segmentationNode)
