@@ -633,6 +633,30 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
     upper[axis] = below[axis][BrickSize - 1] + 1 + margin;
     size[axis] = upper[axis] - lower[axis] + 1;
   }
+  // Most bricks a tool reaches hold no shield: find them from a smaller box
+  // first. The smoothed surface lies within the Gaussian's mean reach
+  // (1.25 sigma in a slice) and half a voxel of the voxel faces; two voxels
+  // more cover the interpolation and the gradient's normalisation.
+  {
+    const double maximumSpacing = std::max({ spacing[0], spacing[1], spacing[2] });
+    const double reach = this->BandWidth + (1.25 * this->SurfaceSmoothing + 2.5) * maximumSpacing;
+    int nearLower[3];
+    int nearUpper[3];
+    size_t nearCount = 1;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const int voxels = static_cast<int>(std::ceil(reach / spacing[axis]));
+      nearLower[axis] = std::max(lower[axis], below[axis][0] - voxels);
+      nearUpper[axis] = std::min(upper[axis], below[axis][BrickSize - 1] + 1 + voxels);
+      nearCount *= static_cast<size_t>(nearUpper[axis] - nearLower[axis] + 1);
+    }
+    scratch.Labels.resize(nearCount);
+    this->GetShieldLabels(nearLower, nearUpper, scratch.Labels.data());
+    if (std::none_of(scratch.Labels.begin(), scratch.Labels.end(), [](uint8_t label) { return label != 0; }))
+    {
+      return nullptr; // nothing shielded within reach: the tool cuts freely
+    }
+  }
   const size_t blockCount = static_cast<size_t>(size[0]) * size[1] * size[2];
   scratch.Labels.resize(blockCount);
   this->GetShieldLabels(lower, upper, scratch.Labels.data());
@@ -670,6 +694,10 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
   const int nu = size[u];
   const int nv = size[v];
   const size_t sliceSize = static_cast<size_t>(nu) * nv;
+  // Only the pixels the samples interpolate between, and their neighbours
+  // for the gradient, need their distance (which itself reads the window).
+  const int region[4] = { below[u][0] - lower[u] - 1, below[u][BrickSize - 1] + 2 - lower[u], below[v][0] - lower[v] - 1,
+    below[v][BrickSize - 1] + 2 - lower[v] };
   scratch.SliceInside.resize(sliceSize);
   scratch.SliceDistance.resize(sliceSize * size[w]);
   for (int slice = 0; slice < size[w]; ++slice)
@@ -690,7 +718,8 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
       std::fill(distance, distance + sliceSize, insideCount == 0 ? bound : -bound);
       continue;
     }
-    vtkVolumeCutSliceDistance::SmoothedSignedDistance(scratch.SliceInside.data(), nu, nv, spacing[u], spacing[v], bound, kernel, distance, scratch.Slice);
+    vtkVolumeCutSliceDistance::SmoothedSignedDistance(
+      scratch.SliceInside.data(), nu, nv, spacing[u], spacing[v], bound, kernel, region, distance, scratch.Slice);
   }
   // Where a slice holds no structure near a pixel but the one beside it does
   // (the end of a structure along the slices' normal): the distance

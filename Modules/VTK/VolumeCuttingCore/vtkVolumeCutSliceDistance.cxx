@@ -52,19 +52,20 @@ void DistanceTransform1D(const double* f, int n, double spacing, double* d, std:
   }
 }
 
-/// Convolve a nu x nv slice with kernel along u (stride 1) or v (stride nu); edges clamped.
-void Convolve(double* values, int nu, int nv, bool alongV, const std::vector<double>& kernel, std::vector<double>& out)
+/// Convolve the rows (along u) or columns (along v) of a nu x nv slice
+/// with kernel, edges clamped, writing only the pixels of [u0, u1] x [v0, v1]
+/// into out (which reads values).
+void Convolve(const double* values, int nu, int nv, bool alongV, const std::vector<double>& kernel, const int region[4], double* out)
 {
   const int radius = static_cast<int>(kernel.size() / 2);
-  out.resize(static_cast<size_t>(nu) * nv);
   const int length = alongV ? nv : nu;
-  const int lines = alongV ? nu : nv;
   const size_t stride = alongV ? static_cast<size_t>(nu) : 1;
-  for (int line = 0; line < lines; ++line)
+  for (int b = region[2]; b <= region[3]; ++b)
   {
-    const size_t first = alongV ? static_cast<size_t>(line) : static_cast<size_t>(line) * nu;
-    for (int n = 0; n < length; ++n)
+    for (int a = region[0]; a <= region[1]; ++a)
     {
+      const int n = alongV ? b : a;
+      const size_t first = alongV ? static_cast<size_t>(a) : static_cast<size_t>(b) * nu;
       double sum = 0.0;
       for (int m = -radius; m <= radius; ++m)
       {
@@ -73,7 +74,6 @@ void Convolve(double* values, int nu, int nv, bool alongV, const std::vector<dou
       out[first + n * stride] = sum;
     }
   }
-  std::copy(out.begin(), out.end(), values);
 }
 } // namespace
 
@@ -98,6 +98,13 @@ std::vector<double> vtkVolumeCutSliceDistance::GaussianKernel(double sigma)
 //------------------------------------------------------------------------------
 void vtkVolumeCutSliceDistance::SquaredDistance2D(const uint8_t* feature, int nu, int nv, double su, double sv, double* squared, Scratch& scratch)
 {
+  SquaredDistance2D(feature, nu, nv, su, sv, 0, nu - 1, squared, scratch);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutSliceDistance::SquaredDistance2D(
+  const uint8_t* feature, int nu, int nv, double su, double sv, int firstColumn, int lastColumn, double* squared, Scratch& scratch)
+{
   const int longest = std::max(nu, nv);
   scratch.Line.resize(longest);
   scratch.Result.resize(longest);
@@ -109,7 +116,7 @@ void vtkVolumeCutSliceDistance::SquaredDistance2D(const uint8_t* feature, int nu
     }
     DistanceTransform1D(scratch.Line.data(), nu, su, squared + static_cast<size_t>(nu) * j, scratch.Parabolas, scratch.Envelope);
   }
-  for (int i = 0; i < nu; ++i)
+  for (int i = firstColumn; i <= lastColumn; ++i)
   {
     for (int j = 0; j < nv; ++j)
     {
@@ -127,6 +134,18 @@ void vtkVolumeCutSliceDistance::SquaredDistance2D(const uint8_t* feature, int nu
 void vtkVolumeCutSliceDistance::SmoothedSignedDistance(const uint8_t* inside, int nu, int nv, double su, double sv, double bound,
   const std::vector<double>& kernel, double* distance, Scratch& scratch)
 {
+  const int whole[4] = { 0, nu - 1, 0, nv - 1 };
+  SmoothedSignedDistance(inside, nu, nv, su, sv, bound, kernel, whole, distance, scratch);
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutSliceDistance::SmoothedSignedDistance(const uint8_t* inside, int nu, int nv, double su, double sv, double bound,
+  const std::vector<double>& kernel, const int region[4], double* distance, Scratch& scratch)
+{
+  // The pixels the Gaussian reads around the region.
+  const int radius = static_cast<int>(kernel.size() / 2);
+  const int read[4] = { std::max(0, region[0] - radius), std::min(nu - 1, region[1] + radius), std::max(0, region[2] - radius),
+    std::min(nv - 1, region[3] + radius) };
   const size_t count = static_cast<size_t>(nu) * nv;
   scratch.Outside.resize(count);
   for (size_t n = 0; n < count; ++n)
@@ -135,17 +154,24 @@ void vtkVolumeCutSliceDistance::SmoothedSignedDistance(const uint8_t* inside, in
   }
   scratch.ToInside.resize(count);
   // distance holds the squared distance to the outside until it becomes signed.
-  SquaredDistance2D(scratch.Outside.data(), nu, nv, su, sv, distance, scratch);
-  SquaredDistance2D(inside, nu, nv, su, sv, scratch.ToInside.data(), scratch);
+  SquaredDistance2D(scratch.Outside.data(), nu, nv, su, sv, read[0], read[1], distance, scratch);
+  SquaredDistance2D(inside, nu, nv, su, sv, read[0], read[1], scratch.ToInside.data(), scratch);
   const double half = 0.25 * (su + sv); // the outline halfway between pixel centres
-  for (size_t n = 0; n < count; ++n)
+  for (int v = read[2]; v <= read[3]; ++v)
   {
-    const double signedDistance = inside[n] ? -(std::sqrt(distance[n]) - half) : std::sqrt(scratch.ToInside[n]) - half;
-    distance[n] = std::min(std::max(signedDistance, -bound), bound);
+    for (int u = read[0]; u <= read[1]; ++u)
+    {
+      const size_t n = u + static_cast<size_t>(nu) * v;
+      const double signedDistance = inside[n] ? -(std::sqrt(distance[n]) - half) : std::sqrt(scratch.ToInside[n]) - half;
+      distance[n] = std::min(std::max(signedDistance, -bound), bound);
+    }
   }
   if (!kernel.empty())
   {
-    Convolve(distance, nu, nv, false, kernel, scratch.Convolved);
-    Convolve(distance, nu, nv, true, kernel, scratch.Convolved);
+    // Along u for the rows the second pass reads, then along v in the region.
+    scratch.Convolved.resize(count);
+    const int rows[4] = { region[0], region[1], read[2], read[3] };
+    Convolve(distance, nu, nv, false, kernel, rows, scratch.Convolved.data());
+    Convolve(scratch.Convolved.data(), nu, nv, true, kernel, region, distance);
   }
 }

@@ -54,9 +54,15 @@ public:
    */
   static void SmoothedSignedDistance(const uint8_t* inside, int nu, int nv, double su, double sv, double bound, const std::vector<double>& kernel,
     double* distance, Scratch& scratch);
+  /// The same, exact only within region (first and last u, first and last v) and computed only as far as that needs.
+  static void SmoothedSignedDistance(const uint8_t* inside, int nu, int nv, double su, double sv, double bound, const std::vector<double>& kernel,
+    const int region[4], double* distance, Scratch& scratch);
 
   /// Squared distance (mm^2) of each pixel of a nu x nv slice to the nearest pixel where feature is non-zero (1e20 where there is none).
   static void SquaredDistance2D(const uint8_t* feature, int nu, int nv, double su, double sv, double* squared, Scratch& scratch);
+  /// The same, exact only in the columns (u) firstColumn..lastColumn.
+  static void SquaredDistance2D(
+    const uint8_t* feature, int nu, int nv, double su, double sv, int firstColumn, int lastColumn, double* squared, Scratch& scratch);
 
 private:
   vtkVolumeCutSliceDistance() = delete;
