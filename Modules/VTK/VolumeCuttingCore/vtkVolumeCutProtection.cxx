@@ -627,8 +627,9 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
       below[axis][n] = static_cast<int>(std::floor(position[axis][n]));
       own[axis][n] = static_cast<int>(std::lround(position[axis][n]));
     }
-    // Along the slices' normal two more slices each side, for the ends' extrapolation.
-    const int margin = axis == w ? 2 : static_cast<int>(std::ceil(bound / spacing[axis])) + kernelRadius + 1;
+    // Along the slices' normal two more slices each side for the ends'
+    // extrapolation, beyond the one the gradient reads.
+    const int margin = axis == w ? 3 : static_cast<int>(std::ceil(bound / spacing[axis])) + kernelRadius + 1;
     lower[axis] = below[axis][0] - margin;
     upper[axis] = below[axis][BrickSize - 1] + 1 + margin;
     size[axis] = upper[axis] - lower[axis] + 1;
@@ -721,32 +722,34 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
     vtkVolumeCutSliceDistance::SmoothedSignedDistance(
       scratch.SliceInside.data(), nu, nv, spacing[u], spacing[v], bound, kernel, region, distance, scratch.Slice);
   }
-  // Where a slice holds no structure near a pixel but the one beside it does
-  // (the end of a structure along the slices' normal): the distance
-  // extrapolated from the last two slices, so that a tapering end (a ball's
-  // pole) closes where its outlines shrink to, but no further than halfway
-  // to the next slice over the last outline (its mirror), as the renderer's
-  // smoothing closes it.
+  // Where a pixel is outside the structure in a slice but inside in the one
+  // beside it (an end of the structure along the slices' normal, or a floor
+  // or roof nearly parallel to the slices): at most the distance
+  // extrapolated from the two slices inside, so that a tapering end (a
+  // ball's pole) closes where its outlines shrink to, but no further than
+  // halfway to the next slice over the last outline (its mirror), as the
+  // renderer's smoothing closes the ends. Taking the smaller keeps an
+  // oblique wall's in-slice distance and changes nothing abruptly where a
+  // farther part of the outline enters the slice.
   scratch.Extrapolated = scratch.SliceDistance;
   for (int slice = 2; slice < size[w] - 2; ++slice)
   {
     for (size_t pixel = 0; pixel < sliceSize; ++pixel)
     {
-      if (scratch.SliceDistance[sliceSize * slice + pixel] < bound)
+      double& closed = scratch.Extrapolated[sliceSize * slice + pixel];
+      if (closed < 0.0)
       {
         continue;
       }
-      double closed = bound;
       for (int direction : { -1, 1 })
       {
         const double last = scratch.SliceDistance[sliceSize * (slice + direction) + pixel];
         const double previous = scratch.SliceDistance[sliceSize * (slice + 2 * direction) + pixel];
-        if (last < bound)
+        if (last < 0.0)
         {
           closed = std::min(closed, std::max(2.0 * last - previous, std::abs(last)));
         }
       }
-      scratch.Extrapolated[sliceSize * slice + pixel] = closed;
     }
   }
 
