@@ -731,23 +731,28 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoo
   // renderer's smoothing closes the ends. Taking the smaller keeps an
   // oblique wall's in-slice distance and changes nothing abruptly where a
   // farther part of the outline enters the slice.
-  scratch.Extrapolated = scratch.SliceDistance;
+  scratch.Extrapolated.resize(scratch.SliceDistance.size());
   for (int slice = 2; slice < size[w] - 2; ++slice)
   {
-    for (size_t pixel = 0; pixel < sliceSize; ++pixel)
+    for (int b = region[2]; b <= region[3]; ++b)
     {
-      double& closed = scratch.Extrapolated[sliceSize * slice + pixel];
-      if (closed < 0.0)
+      for (int a = region[0]; a <= region[1]; ++a)
       {
-        continue;
-      }
-      for (int direction : { -1, 1 })
-      {
-        const double last = scratch.SliceDistance[sliceSize * (slice + direction) + pixel];
-        const double previous = scratch.SliceDistance[sliceSize * (slice + 2 * direction) + pixel];
-        if (last < 0.0)
+        const size_t pixel = a + static_cast<size_t>(nu) * b;
+        double& closed = scratch.Extrapolated[sliceSize * slice + pixel];
+        closed = scratch.SliceDistance[sliceSize * slice + pixel];
+        if (closed < 0.0)
         {
-          closed = std::min(closed, std::max(2.0 * last - previous, std::abs(last)));
+          continue;
+        }
+        for (int direction : { -1, 1 })
+        {
+          const double last = scratch.SliceDistance[sliceSize * (slice + direction) + pixel];
+          const double previous = scratch.SliceDistance[sliceSize * (slice + 2 * direction) + pixel];
+          if (last < 0.0)
+          {
+            closed = std::min(closed, std::max(2.0 * last - previous, std::abs(last)));
+          }
         }
       }
     }
