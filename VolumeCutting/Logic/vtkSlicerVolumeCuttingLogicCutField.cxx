@@ -78,9 +78,20 @@ vtkVolumeCutField* vtkSlicerVolumeCuttingLogic::GetCutField(vtkMRMLVolumeCutNode
     // Nothing the user made is dropped: the cut moves onto the new grid,
     // or the change is refused if the new grid cannot hold all of it.
     newField->ResampleFrom(field);
-    this->UpdateProtection(cutNode, newField, true);
+    // Both volumes with the shield or both without: a field read from a
+    // file has none yet, and counts the ramp of a cut surface that reaches
+    // into a shielded voxel, which the shield's smoothed wall comes close to.
+    const bool shieldedBefore = field->GetProtection()->HasShieldedLabels();
+    if (shieldedBefore)
+    {
+      this->UpdateProtection(cutNode, newField, true);
+    }
     const double before = field->ComputeRemovedVolume();
     const double after = newField->ComputeRemovedVolume();
+    if (!shieldedBefore)
+    {
+      this->UpdateProtection(cutNode, newField, true);
+    }
     if (std::abs(after - before) > 0.01 * before + 1e-6)
     {
       this->ProtectionSources.erase(cutNode->GetID());
@@ -179,6 +190,8 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
   vtkMRMLSegmentationNode* segmentationNode = cutNode->GetSegmentationNode();
   const std::vector<std::string> shieldedIds = GetShieldedSegmentIDs(cutNode);
   vtkSlicerVolumeCuttingSegmentLayers* layers = this->GetSegmentLayers(cutNode);
+  // The wall a tool leaves against a structure is the surface drawn for it.
+  field->GetProtection()->SetSurfaceSmoothing(cutNode->GetLabelSmoothing());
   std::ostringstream source;
   source << field;
   if (segmentationNode)

@@ -213,8 +213,10 @@ public:
    * The shield: the structures a tool must not remove (tool "sensibility",
    * Pflesser et al.). Give it label images and say which of their values are
    * shielded (vtkVolumeCutProtection); it is built brick by brick where tools
-   * reach. The removed region becomes the tool's sweep minus the union of
-   * shielded voxel cubes, sharp edges included, and a tool entering a shielded
+   * reach. The removed region becomes the tool's sweep minus the shielded
+   * structures, bounded by their smoothed surface (or their voxel cubes,
+   * sharp edges included: SetSurfaceSmoothing(0)) and never entering a
+   * shielded voxel, and a tool entering a shielded
    * structure is reported as a contact. Cuts already made are not changed by
    * a new shield. Always present; it follows the field's geometry and is
    * emptied by Initialize. Change it only while no stroke is being written.

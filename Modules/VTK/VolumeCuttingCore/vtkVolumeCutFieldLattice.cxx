@@ -204,6 +204,25 @@ bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
 
   BrickStates bricks;
   const double inverseQuantum = 1.0 / this->Quantum;
+  // The shield keeps every sample of a shielded voxel, not the whole voxel:
+  // its wall (the structure's smoothed surface) may pass between them, where
+  // a finer grid has samples. Those are kept as the source's nearest sample
+  // of the same voxel was, so that a finer grid removes nothing inside a
+  // shielded voxel that the source did not.
+  const bool shielded = source->Protection->HasShieldedLabels();
+  const int sourceFactor = std::max(source->SubVoxelFactor, 1);
+  auto keptBySource = [&](const double ras[3]) {
+    double sourceIndex[3];
+    Transform(source->RASToSubIJK, ras, sourceIndex);
+    int voxel[3];
+    int nearest[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      voxel[axis] = static_cast<int>(std::lround((sourceIndex[axis] + 0.5) / sourceFactor - 0.5));
+      nearest[axis] = std::max(voxel[axis] * sourceFactor, std::min(voxel[axis] * sourceFactor + sourceFactor - 1, static_cast<int>(std::lround(sourceIndex[axis]))));
+    }
+    return source->Protection->GetShieldLabel(voxel[0], voxel[1], voxel[2]) != 0 && source->ReadSample(nearest[0], nearest[1], nearest[2]) >= 0;
+  };
   for (vtkIdType brickId : targets)
   {
     int b[3];
@@ -222,6 +241,10 @@ bool vtkVolumeCutField::ResampleFrom(vtkVolumeCutField* source)
       values[local] = distance >= beyond ? Outside
         : distance <= -beyond            ? Inside
                                          : static_cast<int16_t>(std::lround(std::min(this->BandWidth, std::max(-this->BandWidth, distance)) * inverseQuantum));
+      if (shielded && values[local] < 0 && keptBySource(ras))
+      {
+        values[local] = 0;
+      }
       any |= values[local] != Outside;
     }
     if (any)

@@ -180,6 +180,7 @@ bool vtkVolumeCutField::CutSampledRegion(vtkImageData* distances, vtkImageData* 
     const int anatomyDimensions[3] = { this->Dimensions[0] / f, this->Dimensions[1] / f, this->Dimensions[2] / f };
     const double anatomySpacing[3] = { spacing[0] * f, spacing[1] * f, spacing[2] * f };
     keepOut = vtkSmartPointer<vtkVolumeCutProtection>::New();
+    keepOut->SetSurfaceSmoothing(0.0); // the kept voxels exactly, as given
     keepOut->SetFieldGeometry(anatomyDimensions, f, anatomySpacing, this->BandWidth, this->Quantum);
     const int image = keepOut->AddLabelImage(keep);
     double range[2];

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutProtectionBrick.h"
+#include "vtkVolumeCutSliceDistance.h"
 
 #include "vtkDataArray.h"
 #include "vtkImageData.h"
@@ -46,7 +47,46 @@ void ReadLabels(const T* first, const vtkIdType increments[3], const int count[3
 } // namespace
 
 //------------------------------------------------------------------------------
-vtkVolumeCutProtection::vtkVolumeCutProtection() = default;
+struct vtkVolumeCutProtection::Scratch
+{
+  std::vector<uint8_t> Labels;
+  std::vector<float> Along[3];
+  std::vector<float> PassX;
+  std::vector<uint8_t> LabelX;
+  std::vector<float> PassY;
+  std::vector<uint8_t> LabelY;
+  std::vector<int> Wanted;
+  std::vector<uint8_t> RowFound;
+  std::vector<uint8_t> SliceFound;
+  std::vector<uint8_t> SliceInside;
+  /// The smoothed in-slice distance of every slice of the window, and after the ends' extrapolation.
+  std::vector<double> SliceDistance;
+  std::vector<double> Extrapolated;
+  std::vector<double> Normalized;
+  vtkVolumeCutSliceDistance::Scratch Slice;
+};
+
+//------------------------------------------------------------------------------
+vtkVolumeCutProtection::vtkVolumeCutProtection()
+  : SmoothingKernel(vtkVolumeCutSliceDistance::GaussianKernel(1.0))
+  , BuildScratch(new Scratch)
+  , PrepareScratch(new Scratch)
+{
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutProtection::SetSurfaceSmoothing(double sigma)
+{
+  const double clamped = std::max(0.0, std::min(8.0, std::isfinite(sigma) ? sigma : 0.0));
+  if (clamped == this->SurfaceSmoothing)
+  {
+    return;
+  }
+  this->SurfaceSmoothing = clamped;
+  this->SmoothingKernel = clamped > 0.0 ? vtkVolumeCutSliceDistance::GaussianKernel(clamped) : std::vector<double>();
+  this->ClearBricks();
+  this->Modified();
+}
 
 //------------------------------------------------------------------------------
 vtkVolumeCutProtection::~vtkVolumeCutProtection()
@@ -300,7 +340,7 @@ vtkIdType vtkVolumeCutProtection::PrepareBricks(const vtkIdType* brickIds, vtkId
     {
       continue;
     }
-    this->Publish(brickId, this->BuildBrick(brickId, this->PrepareScratch));
+    this->Publish(brickId, this->BuildBrick(brickId, *this->PrepareScratch));
     ++built;
     this->PreparedBricks.fetch_add(1, std::memory_order_acq_rel);
   }
@@ -320,11 +360,17 @@ const vtkVolumeCutProtection::Brick* vtkVolumeCutProtection::GetBrick(vtkIdType 
     return found == FreeBrick() ? nullptr : found;
   }
   ++this->BricksBuiltOnDemand;
-  return this->Publish(brickId, this->BuildBrick(brickId, this->BuildScratch));
+  return this->Publish(brickId, this->BuildBrick(brickId, *this->BuildScratch));
 }
 
 //------------------------------------------------------------------------------
 std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBrick(vtkIdType brickId, Scratch& scratch) const
+{
+  return this->SurfaceSmoothing > 0.0 ? this->BuildSmoothedBrick(brickId, scratch) : this->BuildVoxelFaceBrick(brickId, scratch);
+}
+
+//------------------------------------------------------------------------------
+std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildVoxelFaceBrick(vtkIdType brickId, Scratch& scratch) const
 {
   const int f = this->SubVoxelFactor;
   const int brickIndex[3] = { static_cast<int>(brickId % this->BrickDimensions[0]),
@@ -542,6 +588,260 @@ std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildBric
 }
 
 //------------------------------------------------------------------------------
+std::unique_ptr<vtkVolumeCutProtection::Brick> vtkVolumeCutProtection::BuildSmoothedBrick(vtkIdType brickId, Scratch& scratch) const
+{
+  const int f = this->SubVoxelFactor;
+  const int brickIndex[3] = { static_cast<int>(brickId % this->BrickDimensions[0]),
+    static_cast<int>((brickId / this->BrickDimensions[0]) % this->BrickDimensions[1]),
+    static_cast<int>(brickId / (static_cast<vtkIdType>(this->BrickDimensions[0]) * this->BrickDimensions[1])) };
+  const double* spacing = this->AnatomySpacing;
+  // Slices across the axis of largest spacing, as the renderer's smoothing.
+  int w = 2;
+  for (int axis = 1; axis >= 0; --axis)
+  {
+    w = spacing[axis] > spacing[w] ? axis : w;
+  }
+  const int u = w == 0 ? 1 : 0;
+  const int v = w == 2 ? 1 : 2;
+  const std::vector<double>& kernel = this->SmoothingKernel;
+  const int kernelRadius = static_cast<int>(kernel.size() / 2);
+  // The in-slice distance is needed exactly up to the band plus what the
+  // Gaussian and the interpolation reach; beyond, it is bounded. The window
+  // holds every outline within that bound of the pixels used, so that
+  // neighbouring bricks find the same surface on their common faces.
+  const double bound = this->BandWidth + (kernelRadius + 2) * std::max(spacing[u], spacing[v]);
+
+  // Per axis: each sample's continuous anatomy index, the voxel centre below
+  // it (the interpolation's first corner), the voxel it lies in, and the window.
+  double position[3][BrickSize];
+  int below[3][BrickSize];
+  int own[3][BrickSize];
+  int lower[3];
+  int upper[3];
+  int size[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    for (int n = 0; n < BrickSize; ++n)
+    {
+      position[axis][n] = (brickIndex[axis] * BrickSize + n + 0.5) / f - 0.5;
+      below[axis][n] = static_cast<int>(std::floor(position[axis][n]));
+      own[axis][n] = static_cast<int>(std::lround(position[axis][n]));
+    }
+    // Along the slices' normal two more slices each side for the ends'
+    // extrapolation, beyond the one the gradient reads.
+    const int margin = axis == w ? 3 : static_cast<int>(std::ceil(bound / spacing[axis])) + kernelRadius + 1;
+    lower[axis] = below[axis][0] - margin;
+    upper[axis] = below[axis][BrickSize - 1] + 1 + margin;
+    size[axis] = upper[axis] - lower[axis] + 1;
+  }
+  // Most bricks a tool reaches hold no shield: find them from a smaller box
+  // first. The smoothed surface lies within the Gaussian's mean reach
+  // (1.25 sigma in a slice) and half a voxel of the voxel faces; two voxels
+  // more cover the interpolation and the gradient's normalisation.
+  {
+    const double maximumSpacing = std::max({ spacing[0], spacing[1], spacing[2] });
+    const double reach = this->BandWidth + (1.25 * this->SurfaceSmoothing + 2.5) * maximumSpacing;
+    int nearLower[3];
+    int nearUpper[3];
+    size_t nearCount = 1;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const int voxels = static_cast<int>(std::ceil(reach / spacing[axis]));
+      nearLower[axis] = std::max(lower[axis], below[axis][0] - voxels);
+      nearUpper[axis] = std::min(upper[axis], below[axis][BrickSize - 1] + 1 + voxels);
+      nearCount *= static_cast<size_t>(nearUpper[axis] - nearLower[axis] + 1);
+    }
+    scratch.Labels.resize(nearCount);
+    this->GetShieldLabels(nearLower, nearUpper, scratch.Labels.data());
+    if (std::none_of(scratch.Labels.begin(), scratch.Labels.end(), [](uint8_t label) { return label != 0; }))
+    {
+      return nullptr; // nothing shielded within reach: the tool cuts freely
+    }
+  }
+  const size_t blockCount = static_cast<size_t>(size[0]) * size[1] * size[2];
+  scratch.Labels.resize(blockCount);
+  this->GetShieldLabels(lower, upper, scratch.Labels.data());
+  uint8_t onlyLabel = 0;
+  bool severalLabels = false;
+  for (uint8_t label : scratch.Labels)
+  {
+    if (label != 0 && label != onlyLabel)
+    {
+      severalLabels |= onlyLabel != 0;
+      onlyLabel = std::max(onlyLabel, label);
+    }
+  }
+  if (onlyLabel == 0)
+  {
+    return nullptr; // nothing shielded within reach: the tool cuts freely
+  }
+  // Which structure each sample lies in or is nearest to, for contacts: the
+  // voxel cubes' brick knows where several structures are near.
+  std::unique_ptr<Brick> brick = severalLabels ? this->BuildVoxelFaceBrick(brickId, scratch) : nullptr;
+  if (severalLabels)
+  {
+    scratch.Labels.resize(blockCount);
+    this->GetShieldLabels(lower, upper, scratch.Labels.data()); // the cubes' brick used the same memory
+  }
+  const bool labelled = brick != nullptr;
+  if (!brick)
+  {
+    brick.reset(new Brick);
+  }
+  const uint8_t* labels = scratch.Labels.data();
+  const size_t stride[3] = { 1, static_cast<size_t>(size[0]), static_cast<size_t>(size[0]) * size[1] };
+
+  // Each slice's smoothed signed distance to the structures' outline.
+  const int nu = size[u];
+  const int nv = size[v];
+  const size_t sliceSize = static_cast<size_t>(nu) * nv;
+  // Only the pixels the samples interpolate between, and their neighbours
+  // for the gradient, need their distance (which itself reads the window).
+  const int region[4] = { below[u][0] - lower[u] - 1, below[u][BrickSize - 1] + 2 - lower[u], below[v][0] - lower[v] - 1,
+    below[v][BrickSize - 1] + 2 - lower[v] };
+  scratch.SliceInside.resize(sliceSize);
+  scratch.SliceDistance.resize(sliceSize * size[w]);
+  for (int slice = 0; slice < size[w]; ++slice)
+  {
+    size_t insideCount = 0;
+    for (int b = 0; b < nv; ++b)
+    {
+      for (int a = 0; a < nu; ++a)
+      {
+        const bool in = labels[stride[u] * a + stride[v] * b + stride[w] * slice] != 0;
+        scratch.SliceInside[a + static_cast<size_t>(nu) * b] = in ? 1 : 0;
+        insideCount += in ? 1 : 0;
+      }
+    }
+    double* distance = &scratch.SliceDistance[sliceSize * slice];
+    if (insideCount == 0 || insideCount == sliceSize)
+    {
+      std::fill(distance, distance + sliceSize, insideCount == 0 ? bound : -bound);
+      continue;
+    }
+    vtkVolumeCutSliceDistance::SmoothedSignedDistance(
+      scratch.SliceInside.data(), nu, nv, spacing[u], spacing[v], bound, kernel, region, distance, scratch.Slice);
+  }
+  // Where a pixel is outside the structure in a slice but inside in the one
+  // beside it (an end of the structure along the slices' normal, or a floor
+  // or roof nearly parallel to the slices): at most the distance
+  // extrapolated from the two slices inside, so that a tapering end (a
+  // ball's pole) closes where its outlines shrink to, but no further than
+  // halfway to the next slice over the last outline (its mirror), as the
+  // renderer's smoothing closes the ends. Taking the smaller keeps an
+  // oblique wall's in-slice distance and changes nothing abruptly where a
+  // farther part of the outline enters the slice.
+  scratch.Extrapolated.resize(scratch.SliceDistance.size());
+  for (int slice = 2; slice < size[w] - 2; ++slice)
+  {
+    for (int b = region[2]; b <= region[3]; ++b)
+    {
+      for (int a = region[0]; a <= region[1]; ++a)
+      {
+        const size_t pixel = a + static_cast<size_t>(nu) * b;
+        double& closed = scratch.Extrapolated[sliceSize * slice + pixel];
+        closed = scratch.SliceDistance[sliceSize * slice + pixel];
+        if (closed < 0.0)
+        {
+          continue;
+        }
+        for (int direction : { -1, 1 })
+        {
+          const double last = scratch.SliceDistance[sliceSize * (slice + direction) + pixel];
+          const double previous = scratch.SliceDistance[sliceSize * (slice + 2 * direction) + pixel];
+          if (last < 0.0)
+          {
+            closed = std::min(closed, std::max(2.0 * last - previous, std::abs(last)));
+          }
+        }
+      }
+    }
+  }
+
+  // At the voxel centres the samples interpolate between: the in-slice
+  // distance divided by its gradient's length. Its zero, the surface, stays;
+  // across the slices it becomes a distance too (an oblique surface's
+  // in-slice distance grows faster than the distance to it), as the field's
+  // reconstruction and its curvature correction expect.
+  const double* smoothed = scratch.Extrapolated.data();
+  auto smoothedAt = [&](const int index[3]) { return smoothed[sliceSize * index[w] + index[u] + static_cast<size_t>(nu) * index[v]]; };
+  int first[3];
+  int count[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    first[axis] = below[axis][0] - lower[axis];
+    count[axis] = below[axis][BrickSize - 1] + 2 - below[axis][0];
+  }
+  scratch.Normalized.resize(static_cast<size_t>(count[0]) * count[1] * count[2]);
+  for (int z = 0; z < count[2]; ++z)
+  {
+    for (int y = 0; y < count[1]; ++y)
+    {
+      for (int x = 0; x < count[0]; ++x)
+      {
+        const int index[3] = { first[0] + x, first[1] + y, first[2] + z };
+        double gradient2 = 0.0;
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          int next[3] = { index[0], index[1], index[2] };
+          int previous[3] = { index[0], index[1], index[2] };
+          ++next[axis];
+          --previous[axis];
+          const double derivative = (smoothedAt(next) - smoothedAt(previous)) / (2.0 * spacing[axis]);
+          gradient2 += derivative * derivative;
+        }
+        scratch.Normalized[(static_cast<size_t>(z) * count[1] + y) * count[0] + x] = smoothedAt(index) / std::max(1.0, std::sqrt(gradient2));
+      }
+    }
+  }
+
+  // Each sample: that distance interpolated between the voxel centres
+  // around it (trilinear, as the renderer samples its fractions), and inside
+  // a shielded voxel never outside the shield.
+  const double inverseQuantum = 1.0 / this->Quantum;
+  bool useful = false;
+  for (int p = 0; p < BrickSize; ++p)
+  {
+    for (int m = 0; m < BrickSize; ++m)
+    {
+      for (int n = 0; n < BrickSize; ++n)
+      {
+        const int corner[3] = { below[0][n] - below[0][0], below[1][m] - below[1][0], below[2][p] - below[2][0] };
+        const double t[3] = { position[0][n] - below[0][n], position[1][m] - below[1][m], position[2][p] - below[2][p] };
+        double interpolated = 0.0;
+        for (int c = 0; c < 8; ++c)
+        {
+          int index[3];
+          double weight = 1.0;
+          for (int axis = 0; axis < 3; ++axis)
+          {
+            const int upperCorner = (c >> axis) & 1;
+            index[axis] = corner[axis] + upperCorner;
+            weight *= upperCorner ? t[axis] : 1.0 - t[axis];
+          }
+          interpolated += weight * scratch.Normalized[(static_cast<size_t>(index[2]) * count[1] + index[1]) * count[0] + index[0]];
+        }
+        const int local = (p * BrickSize + m) * BrickSize + n;
+        const uint8_t ownLabel = labels[stride[0] * (own[0][n] - lower[0]) + stride[1] * (own[1][m] - lower[1]) + stride[2] * (own[2][p] - lower[2])];
+        const double signedDistance = std::max(-this->BandWidth, std::min(this->BandWidth, interpolated));
+        long quantized = std::lround(signedDistance * inverseQuantum);
+        if (ownLabel != 0)
+        {
+          quantized = std::min(quantized, -1L);
+        }
+        brick->Distance[local] = static_cast<int16_t>(quantized);
+        if (ownLabel != 0 || !labelled)
+        {
+          brick->Label[local] = ownLabel != 0 ? ownLabel : onlyLabel;
+        }
+        useful |= quantized * this->Quantum < this->BandWidth;
+      }
+    }
+  }
+  return useful ? std::move(brick) : nullptr;
+}
+
+//------------------------------------------------------------------------------
 size_t vtkVolumeCutProtection::GetMemorySize() const
 {
   size_t bytes = static_cast<size_t>(this->GetNumberOfShieldBricks()) * sizeof(Brick);
@@ -559,6 +859,7 @@ void vtkVolumeCutProtection::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "LabelImages: " << this->LabelImages.size() << "\n";
   os << indent << "HasShieldedLabels: " << (this->HasShieldedLabels() ? "yes" : "no") << "\n";
+  os << indent << "SurfaceSmoothing: " << this->SurfaceSmoothing << "\n";
   os << indent << "Reach (voxels): " << this->Reach[0] << " " << this->Reach[1] << " " << this->Reach[2] << "\n";
   os << indent << "BuiltBricks: " << this->GetNumberOfBuiltBricks() << " (" << this->GetNumberOfShieldBricks() << " with a shield)\n";
   os << indent << "BricksBuiltOnDemand: " << this->BricksBuiltOnDemand << "\n";

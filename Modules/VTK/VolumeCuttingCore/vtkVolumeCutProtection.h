@@ -6,9 +6,17 @@
  *
  * Tool "sensibility" (Pflesser et al., 2002): a tool removes only what it may
  * cut; the anatomy voxels of every other structure are shielded. The shield
- * is the signed distance (mm, negative inside) to the union of the shielded
- * voxel cubes, sampled at the cut field's sub-voxel centres within its band;
- * the writer cuts max(tool, -shield), so creases against a shielded structure
+ * is a signed distance (mm, negative inside) sampled at the cut field's
+ * sub-voxel centres within its band; the writer cuts max(tool, -shield).
+ * By default its zero is the structures' smoothed surface, the one the
+ * renderer draws for segments known only as voxels (vtkVolumeCutSliceDistance:
+ * in-slice distance to the outline, smoothed by a Gaussian of
+ * SurfaceSmoothing voxels, interpolated between slices), so that the wall a
+ * burr leaves against a structure is as smooth as that surface, not a
+ * lattice of voxel steps. Where that surface passes inside a shielded voxel,
+ * the voxel's samples stay shielded all the same (by one quantum): nothing
+ * inside a shielded voxel is ever removed. With SurfaceSmoothing 0 the shield
+ * is the exact distance to the union of the shielded voxel cubes, and creases
  * are exact to the voxel faces.
  *
  * Where the shielded voxels are is read from label images on the anatomy's
@@ -18,9 +26,10 @@
  * nothing in proportion to the volume.
  *
  * The shield is built a brick at a time, the first time a tool reaches the
- * brick, from the labels within the band around it (a separable minimum over
- * the three axes: exact, not an approximation of the distance to the voxel
- * cubes). Nothing is computed for the parts of a patient-scale scan that no
+ * brick, from the labels around it (the smoothed surface: the slices' exact
+ * distance transforms within a window wide enough that every brick finds
+ * the same surface; the voxel cubes: a separable minimum over the three
+ * axes, exact, not an approximation of the distance to the cubes). Nothing is computed for the parts of a patient-scale scan that no
  * tool comes near, and a role change only forgets the bricks built so far.
  *
  * Threads: the images and the table are changed, and bricks are built, by the
@@ -106,6 +115,17 @@ public:
    */
   void SetFieldGeometry(const int anatomyDimensions[3], int subVoxelFactor, const double anatomySpacing[3], double bandWidth, double quantum);
 
+  /**
+   * Width (anatomy voxels, 0..8) of the in-slice Gaussian that smooths the
+   * shielded structures' surface, as vtkVolumeCutRayCaster::SetLabelSmoothing
+   * does for the surface it draws: the same value gives the wall a tool
+   * leaves against a structure the surface drawn for it. 0: the voxel cubes,
+   * stairs included. Either way nothing inside a shielded voxel is removed.
+   * Forgets the bricks built so far (not while the writer cuts). Default 1.
+   */
+  void SetSurfaceSmoothing(double sigma);
+  vtkGetMacro(SurfaceSmoothing, double);
+
   /// Internal: the shield within one brick of the field (vtkVolumeCutProtectionBrick.h).
   struct Brick;
 
@@ -150,6 +170,10 @@ protected:
   struct Scratch;
   /// Builds the shield of one brick in scratch's working memory; nullptr where it would be free.
   std::unique_ptr<Brick> BuildBrick(vtkIdType brickId, Scratch& scratch) const;
+  /// The shield of the voxel cubes (SurfaceSmoothing 0), and the nearest structure of every sample.
+  std::unique_ptr<Brick> BuildVoxelFaceBrick(vtkIdType brickId, Scratch& scratch) const;
+  /// The shield of the smoothed surface (SurfaceSmoothing > 0).
+  std::unique_ptr<Brick> BuildSmoothedBrick(vtkIdType brickId, Scratch& scratch) const;
   /**
    * Put a brick just built (nullptr: free) into the directory unless the
    * other side did first; returns the brick the directory holds then
@@ -175,6 +199,9 @@ protected:
   double Quantum = 1.0;
   /// Anatomy voxels within the band of a sample, along each axis.
   int Reach[3] = { 1, 1, 1 };
+  double SurfaceSmoothing = 1.0;
+  /// The in-slice Gaussian of SurfaceSmoothing.
+  std::vector<double> SmoothingKernel;
 
   /**
    * The built bricks by brick ID: nullptr not built yet, FreeBrick() built
@@ -192,20 +219,8 @@ protected:
   std::mutex PreparerMutex;
 
   /// BuildBrick's working memory, kept between bricks (one for the writer, one for the preparer).
-  struct Scratch
-  {
-    std::vector<uint8_t> Labels;
-    std::vector<float> Along[3];
-    std::vector<float> PassX;
-    std::vector<uint8_t> LabelX;
-    std::vector<float> PassY;
-    std::vector<uint8_t> LabelY;
-    std::vector<int> Wanted;
-    std::vector<uint8_t> RowFound;
-    std::vector<uint8_t> SliceFound;
-  };
-  Scratch BuildScratch;
-  Scratch PrepareScratch;
+  std::unique_ptr<Scratch> BuildScratch;
+  std::unique_ptr<Scratch> PrepareScratch;
 
 private:
   vtkVolumeCutProtection(const vtkVolumeCutProtection&) = delete;

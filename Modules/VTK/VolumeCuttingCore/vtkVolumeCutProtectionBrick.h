@@ -14,7 +14,7 @@
 struct vtkVolumeCutProtection::Brick
 {
   static constexpr int Samples = vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize;
-  /// Signed distance to the union of shielded voxel cubes (field quanta, negative inside).
+  /// Signed distance to the shielded structures' (smoothed) surface, field quanta, negative inside; negative in every shielded voxel.
   int16_t Distance[Samples];
   /// The structure a sample lies in, or the nearest one outside.
   uint8_t Label[Samples];

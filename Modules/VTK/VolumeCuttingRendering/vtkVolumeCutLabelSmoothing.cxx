@@ -3,133 +3,12 @@
 #include "vtkVolumeCutLabelSmoothing.h"
 
 #include "vtkVolumeCutParallelFor.h"
+#include "vtkVolumeCutSliceDistance.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <map>
-
-namespace
-{
-constexpr double Far = 1e20; // squared mm: no feature on this line
-
-/// Squared distance (mm^2) from each of n points \a spacing mm apart to the
-/// nearest feature, given f (0 at features, Far elsewhere, or the squared
-/// distances of a previous pass): Felzenszwalb and Huttenlocher's lower
-/// envelope of parabolas.
-void DistanceTransform1D(const double* f, int n, double spacing, double* d, std::vector<int>& v, std::vector<double>& z)
-{
-  v.resize(n);
-  z.resize(n + 1);
-  int k = 0;
-  v[0] = 0;
-  z[0] = -std::numeric_limits<double>::infinity();
-  z[1] = std::numeric_limits<double>::infinity();
-  auto intersection = [&](int q, int p) {
-    const double xq = q * spacing;
-    const double xp = p * spacing;
-    return ((f[q] + xq * xq) - (f[p] + xp * xp)) / (2.0 * (xq - xp));
-  };
-  for (int q = 1; q < n; ++q)
-  {
-    double s = intersection(q, v[k]);
-    while (s <= z[k])
-    {
-      --k;
-      s = intersection(q, v[k]);
-    }
-    ++k;
-    v[k] = q;
-    z[k] = s;
-    z[k + 1] = std::numeric_limits<double>::infinity();
-  }
-  k = 0;
-  for (int q = 0; q < n; ++q)
-  {
-    const double x = q * spacing;
-    while (z[k + 1] < x)
-    {
-      ++k;
-    }
-    const double dx = x - v[k] * spacing;
-    d[q] = dx * dx + f[v[k]];
-  }
-}
-
-/// Squared distance (mm^2) of each pixel of a nu x nv slice to the nearest
-/// pixel where \a feature is true.
-void DistanceTransform2D(const std::vector<uint8_t>& feature, int nu, int nv, double su, double sv, std::vector<double>& out)
-{
-  out.assign(static_cast<size_t>(nu) * nv, Far);
-  std::vector<double> line(std::max(nu, nv));
-  std::vector<double> result(std::max(nu, nv));
-  std::vector<int> v;
-  std::vector<double> z;
-  for (int j = 0; j < nv; ++j)
-  {
-    for (int i = 0; i < nu; ++i)
-    {
-      line[i] = feature[i + static_cast<size_t>(nu) * j] ? 0.0 : Far;
-    }
-    DistanceTransform1D(line.data(), nu, su, result.data(), v, z);
-    std::copy(result.begin(), result.begin() + nu, out.begin() + static_cast<size_t>(nu) * j);
-  }
-  for (int i = 0; i < nu; ++i)
-  {
-    for (int j = 0; j < nv; ++j)
-    {
-      line[j] = out[i + static_cast<size_t>(nu) * j];
-    }
-    DistanceTransform1D(line.data(), nv, sv, result.data(), v, z);
-    for (int j = 0; j < nv; ++j)
-    {
-      out[i + static_cast<size_t>(nu) * j] = result[j];
-    }
-  }
-}
-
-std::vector<double> GaussianKernel(double sigma)
-{
-  const int radius = std::max(1, static_cast<int>(std::ceil(3.0 * sigma)));
-  std::vector<double> kernel(2 * radius + 1);
-  double sum = 0.0;
-  for (int n = -radius; n <= radius; ++n)
-  {
-    kernel[n + radius] = std::exp(-0.5 * n * n / (sigma * sigma));
-    sum += kernel[n + radius];
-  }
-  for (double& weight : kernel)
-  {
-    weight /= sum;
-  }
-  return kernel;
-}
-
-/// Convolve a nu x nv slice with \a kernel along u (stride 1) or v (stride nu); edges clamped.
-void Convolve(std::vector<double>& values, int nu, int nv, bool alongV, const std::vector<double>& kernel)
-{
-  const int radius = static_cast<int>(kernel.size() / 2);
-  std::vector<double> out(values.size());
-  const int length = alongV ? nv : nu;
-  const int lines = alongV ? nu : nv;
-  const size_t stride = alongV ? static_cast<size_t>(nu) : 1;
-  for (int line = 0; line < lines; ++line)
-  {
-    const size_t first = alongV ? static_cast<size_t>(line) : static_cast<size_t>(line) * nu;
-    for (int n = 0; n < length; ++n)
-    {
-      double sum = 0.0;
-      for (int m = -radius; m <= radius; ++m)
-      {
-        sum += kernel[m + radius] * values[first + std::min(std::max(n + m, 0), length - 1) * stride];
-      }
-      out[first + n * stride] = sum;
-    }
-  }
-  values.swap(out);
-}
-}
 
 //------------------------------------------------------------------------------
 void vtkVolumeCutLabelSmoothing::Smooth(const std::vector<uint16_t>& labelMap, const int dims[3], const double spacing[3],
@@ -151,7 +30,6 @@ void vtkVolumeCutLabelSmoothing::Smooth(const std::vector<uint16_t>& labelMap, c
   // The fraction ramps from 1 to 0 over 2 * ramp mm of distance, wide enough
   // that the slices on either side of an oblique surface stay on it.
   const double ramp = 2.0 * spacing[w];
-  const double half = 0.25 * (spacing[u] + spacing[v]); // outline halfway between pixel centres
   const double reach = ramp + 3.0 * sigma * std::max(spacing[u], spacing[v]);
   const int margin[3] = { static_cast<int>(std::ceil(reach / spacing[0])) + 1, static_cast<int>(std::ceil(reach / spacing[1])) + 1,
     static_cast<int>(std::ceil(reach / spacing[2])) + 1 };
@@ -183,7 +61,7 @@ void vtkVolumeCutLabelSmoothing::Smooth(const std::vector<uint16_t>& labelMap, c
       }
     }
   }
-  const std::vector<double> kernel = sigma > 0.0 ? GaussianKernel(sigma) : std::vector<double>();
+  const std::vector<double> kernel = sigma > 0.0 ? vtkVolumeCutSliceDistance::GaussianKernel(sigma) : std::vector<double>();
   for (int label : labels)
   {
     std::array<int, 6> box = boxes[label];
@@ -203,9 +81,8 @@ void vtkVolumeCutLabelSmoothing::Smooth(const std::vector<uint16_t>& labelMap, c
     const int nv = box[2 * v + 1] - box[2 * v] + 1;
     vtkVolumeCutParallelFor(maximumThreads, box[2 * w + 1] - box[2 * w] + 1, [&](vtkIdType begin, vtkIdType end) {
       std::vector<uint8_t> inside(static_cast<size_t>(nu) * nv);
-      std::vector<uint8_t> outside(inside.size());
-      std::vector<double> toOutside;
-      std::vector<double> toInside;
+      std::vector<double> distance(inside.size());
+      vtkVolumeCutSliceDistance::Scratch scratch;
       for (vtkIdType slice = begin; slice < end; ++slice)
       {
         const vtkIdType origin = stride[w] * (box[2 * w] + slice) + stride[u] * box[2 * u] + stride[v] * box[2 * v];
@@ -215,32 +92,20 @@ void vtkVolumeCutLabelSmoothing::Smooth(const std::vector<uint16_t>& labelMap, c
           {
             const bool in = labelMap[origin + stride[u] * a + stride[v] * b] == label;
             inside[a + static_cast<size_t>(nu) * b] = in ? 1 : 0;
-            outside[a + static_cast<size_t>(nu) * b] = in ? 0 : 1;
           }
         }
         if (std::find(inside.begin(), inside.end(), 1) == inside.end())
         {
           continue; // nothing of the segment in this slice: fraction 0
         }
-        DistanceTransform2D(outside, nu, nv, spacing[u], spacing[v], toOutside);
-        DistanceTransform2D(inside, nu, nv, spacing[u], spacing[v], toInside);
         // Signed distance to the outline (negative inside), bounded where
         // the slice has no outline within reach.
-        for (size_t n = 0; n < toOutside.size(); ++n)
-        {
-          const double distance = inside[n] ? -(std::sqrt(toOutside[n]) - half) : std::sqrt(toInside[n]) - half;
-          toOutside[n] = std::min(std::max(distance, -2.0 * reach), 2.0 * reach);
-        }
-        if (!kernel.empty())
-        {
-          Convolve(toOutside, nu, nv, false, kernel);
-          Convolve(toOutside, nu, nv, true, kernel);
-        }
+        vtkVolumeCutSliceDistance::SmoothedSignedDistance(inside.data(), nu, nv, spacing[u], spacing[v], 2.0 * reach, kernel, distance.data(), scratch);
         for (int b = 0; b < nv; ++b)
         {
           for (int a = 0; a < nu; ++a)
           {
-            const double f = 0.5 - toOutside[a + static_cast<size_t>(nu) * b] / (2.0 * ramp);
+            const double f = 0.5 - distance[a + static_cast<size_t>(nu) * b] / (2.0 * ramp);
             fraction.Values[origin + stride[u] * a + stride[v] * b] = static_cast<float>(std::min(1.0, std::max(0.0, f)));
           }
         }
