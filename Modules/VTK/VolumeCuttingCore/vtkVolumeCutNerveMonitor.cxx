@@ -4,11 +4,13 @@
 #include "vtkVolumeCutNerveMonitorField.h"
 
 #include "vtkDataArray.h"
+#include "vtkDoubleArray.h"
 #include "vtkImageData.h"
 #include "vtkMatrix4x4.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
+#include "vtkPoints.h"
 #include "vtkSmartPointer.h"
 #include "vtkVolumeCutTool.h"
 
@@ -657,6 +659,43 @@ int vtkVolumeCutNerveMonitor::Measure(const double centre[3], double radius, Rea
     reading.FiringRate = snapshot.Rate(reading.Distance);
   }
   return count;
+}
+
+//------------------------------------------------------------------------------
+bool vtkVolumeCutNerveMonitor::MeasureAlong(vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds)
+{
+  if (!centres || !distances)
+  {
+    vtkErrorMacro("MeasureAlong: centres and an array for the distances are required");
+    return false;
+  }
+  const int structures = this->GetNumberOfStructures();
+  const vtkIdType count = centres->GetNumberOfPoints();
+  distances->SetNumberOfComponents(std::max(structures, 1));
+  distances->SetNumberOfTuples(count);
+  if (microseconds)
+  {
+    microseconds->SetNumberOfComponents(1);
+    microseconds->SetNumberOfTuples(count);
+  }
+  std::vector<Reading> readings(std::max(structures, 1));
+  for (vtkIdType n = 0; n < count; ++n)
+  {
+    double centre[3];
+    centres->GetPoint(n, centre);
+    const auto start = std::chrono::steady_clock::now();
+    this->Measure(centre, radius, readings.data(), static_cast<int>(readings.size()));
+    const auto end = std::chrono::steady_clock::now();
+    for (int index = 0; index < std::max(structures, 1); ++index)
+    {
+      distances->SetTypedComponent(n, index, index < structures ? readings[index].Distance : std::numeric_limits<double>::quiet_NaN());
+    }
+    if (microseconds)
+    {
+      microseconds->SetValue(n, std::chrono::duration<double, std::micro>(end - start).count());
+    }
+  }
+  return true;
 }
 
 //------------------------------------------------------------------------------

@@ -51,8 +51,10 @@
 #include <string> // For structure names
 #include <vector> // For readings
 
+class vtkDoubleArray;
 class vtkImageData;
 class vtkMatrix4x4;
+class vtkPoints;
 class vtkVolumeCutTool;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutNerveMonitor : public vtkObject
@@ -190,6 +192,15 @@ public:
    * structure, up to capacity). Returns the number of structures.
    */
   VTK_WRAPEXCLUDE int Measure(const double centre[3], double radius, Reading* readings, int capacity) const;
+
+  /**
+   * Measure for a burr of radius at each of centres (RAS), as Measure: the
+   * distances (one tuple of GetNumberOfStructures components per centre)
+   * into distances and, unless nullptr, each measurement's duration (us)
+   * into microseconds: a trajectory's readings, and the per-tick cost from
+   * Python. False (and an error) without centres or distances.
+   */
+  bool MeasureAlong(vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds);
 
   /**
    * Points on tool's surface (its frame) where MeasureTool reads, made on
