@@ -114,15 +114,34 @@ void Sweep(const LevelGrid& grid, FootPoints& feet, bool forward)
     }
   }
   const int* dims = grid.Dims;
+  vtkIdType linear[13];
+  for (int n = 0; n < 13; ++n)
+  {
+    linear[n] = grid.Index(offsets[n][0], offsets[n][1], offsets[n][2]) - grid.Index(0, 0, 0);
+  }
   const int step = forward ? 1 : -1;
   for (int k = forward ? 0 : dims[2] - 1; k >= 0 && k < dims[2]; k += step)
   {
     for (int j = forward ? 0 : dims[1] - 1; j >= 0 && j < dims[1]; j += step)
     {
+      const bool innerRow = k > 0 && j > 0 && k < dims[2] - 1 && j < dims[1] - 1;
       for (int i = forward ? 0 : dims[0] - 1; i >= 0 && i < dims[0]; i += step)
       {
         const vtkIdType voxel = grid.Index(i, j, k);
         const double p[3] = { i * grid.Spacing[0], j * grid.Spacing[1], k * grid.Spacing[2] };
+        if (innerRow && i > 0 && i < dims[0] - 1)
+        {
+          // Away from the grid's faces every neighbour exists: no bounds to check.
+          for (const vtkIdType offset : linear)
+          {
+            const int32_t foot = feet.Nearest[voxel + offset];
+            if (foot >= 0 && foot != feet.Nearest[voxel])
+            {
+              feet.Offer(voxel, foot, p);
+            }
+          }
+          continue;
+        }
         for (const int* offset : offsets)
         {
           const int ni = i + offset[0], nj = j + offset[1], nk = k + offset[2];

@@ -165,7 +165,7 @@ class MonitorRecording:
         nearest = sorted(self.distances_mm, key=lambda name: min((d for d in self.distances_mm[name] if not math.isnan(d)),
                                                                   default=math.inf))[:shown]
         top = max(silent + 2.0, 1.0)
-        figure, axes = pyplot.subplots(figsize=(9, 4.8), dpi=110)
+        figure, axes = pyplot.subplots(figsize=(10.5, 4.8), dpi=110)
         bands = [("contact", -1.0, 0.0), ("continuous", 0.0, bursts), ("bursts", bursts, sparse),
                  ("sparse clicks", sparse, silent), ("silent", silent, top)]
         for level, low, high in bands:
@@ -180,7 +180,8 @@ class MonitorRecording:
         axes.set_xlabel("time (s)")
         axes.set_ylabel("distance from the burr's surface (mm)")
         axes.set_title(title)
-        axes.legend(loc="lower left", fontsize=8, framealpha=0.9)
+        # Beside the plot, where it hides no reading.
+        axes.legend(loc="upper left", bbox_to_anchor=(1.12, 1.0), fontsize=8, frameon=False)
         figure.tight_layout()
         figure.savefig(path)
         pyplot.close(figure)
