@@ -108,6 +108,28 @@ def table_rows(table_node) -> list:
     return rows
 
 
+def recording_along(monitor, centres, radius: float, period_s: float) -> "MonitorRecording":
+    """Readings for a burr of ``radius`` at each of ``centres`` (RAS, one per ``period_s``), as a recording."""
+    import numpy as np
+    from vtkmodules.util import numpy_support
+    import vtk
+
+    points = vtk.vtkPoints()
+    points.SetData(numpy_support.numpy_to_vtk(np.ascontiguousarray(centres, dtype=float).reshape(-1, 3), deep=1))
+    distances = vtk.vtkDoubleArray()
+    monitor.MeasureAlong(points, float(radius), distances, None)
+    values = numpy_support.vtk_to_numpy(distances).reshape(len(centres), -1)
+    names = [monitor.GetStructureName(index) for index in range(monitor.GetNumberOfStructures())]
+    recording = MonitorRecording(thresholds(monitor))
+    for tick, row in enumerate(values):
+        recording.add(tick * period_s, {name: {
+            "distance_mm": None if math.isnan(row[index]) else float(row[index]),
+            "level": level_name(monitor.GetLevelOfDistance(float(row[index]))),
+            "firing_rate_hz": float(monitor.GetFiringRateOfDistance(float(row[index]))),
+        } for index, name in enumerate(names)})
+    return recording
+
+
 @dataclass
 class MonitorRecording:
     """Readings of one monitor over time, for a summary and a plot."""
@@ -175,7 +197,7 @@ class MonitorRecording:
         for name in nearest:
             axes.plot(self.times_s, [min(d, top) for d in self.distances_mm[name]], label=name, linewidth=1.6)
         axes.set_ylim(-0.5, top)
-        if self.times_s:
+        if len(self.times_s) > 1:
             axes.set_xlim(self.times_s[0], self.times_s[-1])
         axes.set_xlabel("time (s)")
         axes.set_ylabel("distance from the burr's surface (mm)")

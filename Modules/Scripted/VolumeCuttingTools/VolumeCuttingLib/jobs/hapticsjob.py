@@ -11,8 +11,9 @@ node's field by the haptic thread, and, at display rate on this thread, the
 tool node moved and the cut node's events sent (``vtkSlicerVolumeCuttingHapticSession``).
 The forces felt are recorded too (``haptic_replay.vchr``), and so is the
 virtual nerve monitor on the protected structures (every tick measures it;
-its readings at display rate go to ``nerve_monitor.png``: distance per
-structure over time over the threshold bands).
+the burr's positions of every tick, as the recorder kept them, give its
+readings at 1 kHz for ``nerve_monitor.png``: distance per structure over
+time over the threshold bands, whatever the display rate).
 """
 
 from __future__ import annotations
@@ -167,7 +168,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     build_started = time.perf_counter()
     monitor = nervemonitor.monitor_for(logic, cut_node)
     monitor_build_s = time.perf_counter() - build_started
-    monitor_recording = nervemonitor.MonitorRecording(nervemonitor.thresholds(monitor) if monitor else {})
+    display_readings = nervemonitor.MonitorRecording(nervemonitor.thresholds(monitor) if monitor else {})
     started = time.perf_counter()
     if not session.Start(cut_node, replay):
         cut_node.RemoveObserver(observer)
@@ -181,7 +182,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
                 time.sleep(DISPLAY_PERIOD_S)
             session.Update()
             if monitor is not None:
-                monitor_recording.add(time.perf_counter() - started, nervemonitor.readings(monitor))
+                display_readings.add(time.perf_counter() - started, nervemonitor.readings(monitor))
             if frame is not None:
                 frame()
             frames += 1
@@ -192,18 +193,6 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         cut_node.RemoveObserver(observer)
     wall_s = time.perf_counter() - started
     replayed.WriteFile(str(out_dir / "haptic_replay.vchr"))
-    nerve_monitor = {"monitored": 0}
-    if monitor is not None:
-        nerve_monitor = {
-            "monitored": monitor.GetNumberOfStructures(),
-            "fields_build_s": round(monitor_build_s, 3),
-            "fields_memory_mib": round(monitor.GetMemorySize() / 2**20, 1),
-            "plot": str(monitor_recording.plot(out_dir / "nerve_monitor.png",
-                                               title="Virtual nerve monitor during the haptic replay")),
-            "table_rows": logic.GetNerveMonitorTableNode(cut_node).GetTable().GetNumberOfRows(),
-            **monitor_recording.summary(),
-        }
-
     magnitudes = []
     proxies = []
     drilling = []
@@ -218,6 +207,20 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     magnitudes = np.array(magnitudes)
     drilling = np.array(drilling, dtype=bool)
     proxies = np.array(proxies)
+    nerve_monitor = {"monitored": 0}
+    if monitor is not None:
+        # The ticks measured the burr at its proxy: the same fields at the same positions give their readings.
+        ticks_recording = nervemonitor.recording_along(monitor, proxies, tool.GetCuttingRadius(), 1.0 / RATE_HZ)
+        nerve_monitor = {
+            "monitored": monitor.GetNumberOfStructures(),
+            "fields_build_s": round(monitor_build_s, 3),
+            "fields_memory_mib": round(monitor.GetMemorySize() / 2**20, 1),
+            "plot": str(ticks_recording.plot(out_dir / "nerve_monitor.png",
+                                             title="Virtual nerve monitor during the haptic replay (every tick)")),
+            "table_rows": logic.GetNerveMonitorTableNode(cut_node).GetTable().GetNumberOfRows(),
+            "display_updates": display_readings.summary()["samples"],
+            **ticks_recording.summary(),
+        }
     # How deep the burr's centre went past the surface it started from.
     deepest = float(np.max((proxies - surface) @ direction)) if len(proxies) else 0.0
     tool_pose = vtk.vtkMatrix4x4()
