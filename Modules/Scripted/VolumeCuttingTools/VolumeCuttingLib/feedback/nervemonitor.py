@@ -174,8 +174,12 @@ class MonitorRecording:
             }
         return {"thresholds_mm": dict(self.thresholds_mm), "samples": len(self.times_s), "structures": result}
 
-    def plot(self, path, title: str = "Virtual nerve monitor", shown: int = 6) -> Path:
-        """Write a PNG: distance per structure over time over the threshold bands (the ``shown`` nearest structures)."""
+    def plot(self, path, title: str = "Virtual nerve monitor", shown: int = 6, exact_below_mm: float | None = None) -> Path:
+        """Write a PNG: distance per structure over time over the threshold bands (the ``shown`` nearest structures).
+
+        ``exact_below_mm``: the distance beyond which readings are lower bounds
+        (the monitor's range less the burr's radius), drawn as a dashed line.
+        """
         import matplotlib
         matplotlib.use("Agg")
         from matplotlib import pyplot
@@ -186,7 +190,9 @@ class MonitorRecording:
         bursts = self.thresholds_mm.get("bursts_above_mm", 1.0)
         nearest = sorted(self.distances_mm, key=lambda name: min((d for d in self.distances_mm[name] if not math.isnan(d)),
                                                                   default=math.inf))[:shown]
-        top = max(silent + 2.0, 1.0)
+        # Up to the farthest reading shown (within 15 mm): far structures stay in view too.
+        farthest = max((d for name in nearest for d in self.distances_mm[name] if not math.isnan(d)), default=0.0)
+        top = max(silent + 2.0, min(farthest, 15.0) + 0.5)
         figure, axes = pyplot.subplots(figsize=(10.5, 4.8), dpi=110)
         bands = [("contact", -1.0, 0.0), ("continuous", 0.0, bursts), ("bursts", bursts, sparse),
                  ("sparse clicks", sparse, silent), ("silent", silent, top)]
@@ -196,6 +202,10 @@ class MonitorRecording:
                       va="center", fontsize=8, color="#444444")
         for name in nearest:
             axes.plot(self.times_s, [min(d, top) for d in self.distances_mm[name]], label=name, linewidth=1.6)
+        if exact_below_mm is not None and exact_below_mm < top:
+            axes.axhline(exact_below_mm, color="#555555", linestyle="--", linewidth=0.8)
+            axes.text(0.005, exact_below_mm + 0.1, "beyond the monitor's range: lower bounds", fontsize=7, color="#555555",
+                      transform=axes.get_yaxis_transform())
         axes.set_ylim(-0.5, top)
         if len(self.times_s) > 1:
             axes.set_xlim(self.times_s[0], self.times_s[-1])
