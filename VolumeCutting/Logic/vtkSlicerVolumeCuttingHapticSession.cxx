@@ -19,6 +19,7 @@
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkMRMLVolumeCutToolNode.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutNerveMonitor.h"
 
 // MRML includes
 #include <vtkMRMLMarkupsNode.h>
@@ -205,6 +206,8 @@ bool vtkSlicerVolumeCuttingHapticSession::Start(vtkMRMLVolumeCutNode* cutNode, v
   this->Loop->SetForceModel(this->ForceModel);
   this->Loop->SetCutField(field);
   this->Loop->SetToolRotation(rotation);
+  // Each tick reads the monitor too; its fields are built on the logic's worker, never in a tick.
+  this->Loop->SetNerveMonitor(this->Logic ? this->Logic->GetNerveMonitor(cutNode) : nullptr);
   if (!this->Loop->SetDeviceToRAS(deviceToRAS) || !this->Loop->Start())
   {
     vtkErrorMacro("Start: the haptic loop could not start (see the error above)");
@@ -240,6 +243,13 @@ int vtkSlicerVolumeCuttingHapticSession::Update()
   if (this->Logic && this->Loop->GetLatestToolPose(this->Pose))
   {
     this->Logic->MoveActiveTool(this->CutNode, this->Pose, vtkSlicerVolumeCuttingLogic::ToolFollow);
+  }
+  // The nerve monitor as the latest tick read it.
+  vtkVolumeCutNerveMonitor::Reading readings[vtkHapticLoop::MaximumNerveReadings];
+  const int readingCount = this->Loop->GetNerveMonitor() ? this->Loop->GetLatestNerveReadings(readings, vtkHapticLoop::MaximumNerveReadings) : -1;
+  if (this->Logic && readingCount >= 0)
+  {
+    this->Logic->UpdateNerveMonitorWithReadings(this->CutNode, readings, readingCount);
   }
   if ((cuts > 0) != this->Drilling)
   {

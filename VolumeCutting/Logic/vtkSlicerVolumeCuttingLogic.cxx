@@ -18,6 +18,7 @@
 #include "vtkMRMLVolumeCutToolNode.h"
 #include "vtkSlicerVolumeCuttingSegmentImages.h"
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
+#include "vtkSlicerVolumeCuttingNerveMonitors.h"
 #include "vtkSlicerVolumeCuttingToolCache.h"
 #include "vtkVolumeCutMaterialRemoval.h"
 #include "vtkVolumeCutRemovedVoxels.h"
@@ -91,6 +92,7 @@ void AddLabelAsSegment(vtkSegmentation* segmentation, vtkImageData* labels, unsi
 //----------------------------------------------------------------------------
 vtkSlicerVolumeCuttingLogic::vtkSlicerVolumeCuttingLogic()
   : ToolCache(vtkSmartPointer<vtkSlicerVolumeCuttingToolCache>::New())
+  , NerveMonitors(vtkSmartPointer<vtkSlicerVolumeCuttingNerveMonitors>::New())
 {
   RegisterSegmentationConverterRules();
 }
@@ -174,6 +176,7 @@ void vtkSlicerVolumeCuttingLogic::ForgetNode(const std::string& nodeId)
   this->ShieldedSegments.erase(nodeId);
   this->ReportedContactDepths.erase(nodeId);
   this->ToolCache->Forget(nodeId);
+  this->NerveMonitors->Forget(nodeId);
   this->StrokePoses.erase(nodeId);
 }
 
@@ -188,6 +191,7 @@ void vtkSlicerVolumeCuttingLogic::ForgetAllNodes()
   this->ShieldedSegments.clear();
   this->ReportedContactDepths.clear();
   this->ToolCache->ForgetAll();
+  this->NerveMonitors->ForgetAll();
   this->StrokePoses.clear();
 }
 

@@ -21,7 +21,9 @@
 #include <vector>
 
 // VTK includes
+#include <vtkCommand.h>
 #include <vtkSmartPointer.h>
+#include <vtkWrappingHints.h>
 
 
 #include "vtkSlicerVolumeCuttingModuleLogicExport.h"
@@ -32,7 +34,9 @@ class vtkMRMLTableNode;
 class vtkFloatArray;
 class vtkIdTypeArray;
 class vtkSlicerVolumeCuttingSegmentLayers;
+class vtkSlicerVolumeCuttingNerveMonitors;
 class vtkSlicerVolumeCuttingToolCache;
+class vtkVolumeCutNerveMonitor;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
 class vtkMRMLVolumeCutNode;
@@ -183,6 +187,39 @@ public:
   bool RedoStroke(vtkMRMLVolumeCutNode* cutNode);
   ///@}
 
+  ///@{
+  /// The virtual nerve monitor (seed 003) of a cut node: the distance from
+  /// the active tool's surface to each monitored segment's smoothed surface,
+  /// a level and a firing rate (vtkVolumeCutNerveMonitor). Monitored: the
+  /// node's protected segments, unless SetMonitoredSegmentIDs chose others
+  /// (an empty list goes back to the protected ones). MoveActiveTool updates
+  /// it at every pose of the mouse or a replay, a haptic session at every
+  /// tick (shown at display rate). Its distance fields are built on a worker
+  /// thread when the monitored segments change: readings are "not ready"
+  /// meanwhile, nothing waits (WaitForNerveMonitor does, for scripts and
+  /// tests). A change of level invokes NerveMonitorLevelChangedEvent on the
+  /// logic (call data: the cut node); readings are appended to the table
+  /// GetNerveMonitorTableNode (Time in s, Segment, Name, Distance in mm,
+  /// Level). nullptr when nothing is monitored or NerveMonitoring is off.
+  vtkVolumeCutNerveMonitor* GetNerveMonitor(vtkMRMLVolumeCutNode* cutNode);
+  void SetMonitoredSegmentIDs(vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds);
+  std::vector<std::string> GetMonitoredSegmentIDs(vtkMRMLVolumeCutNode* cutNode);
+  bool WaitForNerveMonitor(vtkMRMLVolumeCutNode* cutNode);
+  vtkMRMLTableNode* GetNerveMonitorTableNode(vtkMRMLVolumeCutNode* cutNode);
+  /// Take readings made elsewhere (a haptic tick's) as the monitor's current ones.
+  VTK_WRAPEXCLUDE void UpdateNerveMonitorWithReadings(vtkMRMLVolumeCutNode* cutNode, const void* readings, int count);
+  /// Whether MoveActiveTool updates the monitor. Default is on.
+  vtkSetMacro(NerveMonitoring, bool);
+  vtkGetMacro(NerveMonitoring, bool);
+  vtkBooleanMacro(NerveMonitoring, bool);
+  /// The helper that keeps the monitors and their tables.
+  vtkSlicerVolumeCuttingNerveMonitors* GetNerveMonitors();
+  enum Events
+  {
+    NerveMonitorLevelChangedEvent = vtkCommand::UserEvent + 2560
+  };
+  ///@}
+
   /// Volume (mm^3) removed inside a segment: the cut field's removed fraction
   /// of each anatomy voxel, summed over the segment's voxels (resampled to the
   /// anatomy's grid if needed). A shielded segment reports exactly 0 where
@@ -326,6 +363,11 @@ protected:
   bool SweepActiveTool(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* pose0, vtkMatrix4x4* pose1, bool cut);
   /// Cutting tools of the tool nodes, built once per change of a tool node.
   vtkSmartPointer<vtkSlicerVolumeCuttingToolCache> ToolCache;
+  /// Nerve monitors and their tables, per cut node.
+  vtkSmartPointer<vtkSlicerVolumeCuttingNerveMonitors> NerveMonitors;
+  bool NerveMonitoring = true;
+  /// New readings for the active tool at a pose; invokes the event on a change of level.
+  void UpdateNerveMonitor(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* toolToRAS);
   /// The active tool's last pose in the open stroke, per cut-node ID.
   std::map<std::string, vtkSmartPointer<vtkMatrix4x4>> StrokePoses;
 

@@ -255,6 +255,10 @@ bool vtkSlicerVolumeCuttingLogic::MoveActiveTool(vtkMRMLVolumeCutNode* cutNode, 
     }
     previous->DeepCopy(toolToRAS);
   }
+  if (this->NerveMonitoring)
+  {
+    this->UpdateNerveMonitor(cutNode, toolToRAS);
+  }
   return accepted;
 }
 

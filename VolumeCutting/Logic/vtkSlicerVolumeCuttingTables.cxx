@@ -103,6 +103,38 @@ vtkMRMLTableNode* vtkSlicerVolumeCuttingTables::GetContactTable(vtkMRMLScene* sc
 }
 
 //----------------------------------------------------------------------------
+vtkMRMLTableNode* vtkSlicerVolumeCuttingTables::GetNerveMonitorTable(vtkMRMLScene* scene, vtkMRMLVolumeCutNode* cutNode, const char* role)
+{
+  const bool existed = cutNode->GetNodeReference(role) != nullptr;
+  vtkMRMLTableNode* table = GetReferencedTable(scene, cutNode, role, "nerve monitor", { "Time", "Segment", "Name", "Distance", "Level" });
+  if (table && !existed)
+  {
+    table->SetColumnUnitLabel("Time", "s");
+    table->SetColumnDescription("Time", "Since the monitor started");
+    table->SetColumnUnitLabel("Distance", "mm");
+    table->SetColumnDescription("Distance", "From the tool's surface to the segment's smoothed surface (negative: inside)");
+    table->SetColumnDescription("Level", "silent, sparse clicks, bursts, continuous or contact");
+  }
+  return table;
+}
+
+//----------------------------------------------------------------------------
+void vtkSlicerVolumeCuttingTables::AddNerveReading(
+  vtkMRMLTableNode* table, double time, const std::string& segmentId, const std::string& name, double distance, const char* level)
+{
+  const int row = table->AddEmptyRow();
+  std::ostringstream value;
+  value << time;
+  table->SetCellText(row, 0, value.str().c_str());
+  table->SetCellText(row, 1, segmentId.c_str());
+  table->SetCellText(row, 2, name.c_str());
+  value.str("");
+  value << distance;
+  table->SetCellText(row, 3, value.str().c_str());
+  table->SetCellText(row, 4, level);
+}
+
+//----------------------------------------------------------------------------
 void vtkSlicerVolumeCuttingTables::FillRemovedVolumeTable(
   vtkMRMLTableNode* table, vtkMRMLVolumeCutNode* cutNode, const std::vector<std::string>& segmentIds, const std::map<std::string, double>& volumes)
 {

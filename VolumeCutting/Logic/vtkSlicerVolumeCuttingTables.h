@@ -57,6 +57,12 @@ public:
   /// Add a row to a contact table: the segment touched (ID, and its name in
   /// the cut node's segmentation), now in UTC, the depth (mm) and position (RAS).
   static void AddContact(vtkMRMLTableNode* table, vtkMRMLVolumeCutNode* cutNode, const std::string& segmentId, double depth, const double position[3]);
+  /// The cut node's nerve-monitor table (Time in s, Segment, Name, Distance
+  /// in mm, Level), added and referenced under \a role when the node references none.
+  static vtkMRMLTableNode* GetNerveMonitorTable(vtkMRMLScene* scene, vtkMRMLVolumeCutNode* cutNode, const char* role);
+  /// Add a row to a nerve-monitor table: a reading of one monitored segment.
+  static void AddNerveReading(
+    vtkMRMLTableNode* table, double time, const std::string& segmentId, const std::string& name, double distance, const char* level);
 
 protected:
   vtkSlicerVolumeCuttingTables();

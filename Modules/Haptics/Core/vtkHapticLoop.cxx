@@ -13,6 +13,7 @@
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutNerveMonitor.h"
 #include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutTool.h"
 
@@ -107,6 +108,13 @@ double Percentile(std::vector<float> values, double percent)
 }
 } // namespace
 
+/// The nerve monitor's readings of one tick, as published for the display side.
+struct NerveReadings
+{
+  int Count = -1;
+  vtkVolumeCutNerveMonitor::Reading Values[vtkHapticLoop::MaximumNerveReadings];
+};
+
 struct vtkHapticLoop::Internals
 {
   vtkSmartPointer<vtkHapticDevice> Device;
@@ -114,6 +122,8 @@ struct vtkHapticLoop::Internals
   vtkSmartPointer<vtkHapticForceModel> Model;
   vtkSmartPointer<vtkVolumeCutField> Field;
   vtkSmartPointer<vtkHapticRecorder> Recorder;
+  vtkSmartPointer<vtkVolumeCutNerveMonitor> Monitor;
+  vtkHapticLatestValue<NerveReadings> LatestNerve;
   double DeviceToRAS[4][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } };
   double Scale = 1.0;
   double MapRotation[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
@@ -291,6 +301,36 @@ vtkHapticRecorder* vtkHapticLoop::GetRecorder()
 }
 
 //------------------------------------------------------------------------------
+void vtkHapticLoop::SetNerveMonitor(vtkVolumeCutNerveMonitor* monitor)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetNerveMonitor: stop the loop first");
+    return;
+  }
+  this->Internal->Monitor = monitor;
+  this->Modified();
+}
+
+vtkVolumeCutNerveMonitor* vtkHapticLoop::GetNerveMonitor()
+{
+  return this->Internal->Monitor;
+}
+
+//------------------------------------------------------------------------------
+int vtkHapticLoop::GetLatestNerveReadings(void* readings, int capacity) const
+{
+  NerveReadings latest;
+  if (!this->Internal->LatestNerve.Load(latest) || latest.Count < 0)
+  {
+    return -1;
+  }
+  const int count = std::min({ latest.Count, capacity, MaximumNerveReadings });
+  std::copy(latest.Values, latest.Values + std::max(count, 0), static_cast<vtkVolumeCutNerveMonitor::Reading*>(readings));
+  return count;
+}
+
+//------------------------------------------------------------------------------
 bool vtkHapticLoop::SetDeviceToRAS(vtkMatrix4x4* deviceToRAS)
 {
   if (!deviceToRAS || this->IsRunning())
@@ -414,6 +454,12 @@ bool vtkHapticLoop::Prepare()
   internal.Tool = internal.Model->GetTool();
   internal.Radius = internal.Model->GetSphereRadius();
   internal.ToolReach = internal.Tool ? internal.Tool->GetBoundingRadius() : internal.Radius;
+  // The monitor's points on a tool of another shape are placed here, not in a tick.
+  if (internal.Monitor && internal.Tool && !internal.Monitor->PrepareTool(internal.Tool))
+  {
+    vtkErrorMacro("Start: the nerve monitor could not place points on the tool (see the error above)");
+    return false;
+  }
   if (internal.Recorder)
   {
     internal.Recorder->GetCapabilities()->DeepCopy(capabilities);
@@ -825,6 +871,15 @@ void vtkHapticLoop::Tick(double timeStep)
   display.Drilling = drilling ? 1 : 0;
   display.ContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
   internal.Latest.Store(display);
+
+  if (internal.Monitor)
+  {
+    NerveReadings readings;
+    readings.Count = internal.Tool ? internal.Monitor->MeasureTool(display.ToolToRAS, readings.Values, MaximumNerveReadings)
+                                   : internal.Monitor->Measure(result.ProxyPosition, internal.Radius, readings.Values, MaximumNerveReadings);
+    readings.Count = std::min(readings.Count, static_cast<int>(MaximumNerveReadings));
+    internal.LatestNerve.Store(readings);
+  }
 
   if (internal.Recorder)
   {

@@ -55,6 +55,7 @@
 
 #include "vtkObject.h"
 #include "vtkSmartPointer.h"               // For the parts
+#include "vtkWrappingHints.h"               // For VTK_WRAPEXCLUDE
 #include "vtkVolumeCuttingHapticsExport.h" // For export macro
 
 #include <memory> // For the internals
@@ -64,6 +65,7 @@ class vtkHapticForceModel;
 class vtkHapticRecorder;
 class vtkMatrix4x4;
 class vtkVolumeCutField;
+class vtkVolumeCutNerveMonitor;
 class vtkVolumeCutTool;
 
 class VTK_VOLUMECUTTINGHAPTICS_EXPORT vtkHapticLoop : public vtkObject
@@ -90,6 +92,19 @@ public:
   vtkVolumeCutField* GetCutField();
   void SetRecorder(vtkHapticRecorder* recorder);
   vtkHapticRecorder* GetRecorder();
+  ///@}
+
+  ///@{
+  /**
+   * A nerve monitor (nullptr: none) that each tick reads with the tool's
+   * pose, after its cut: lock-free, on the fields its builder published
+   * (structures still being built read as not ready). The tick's readings
+   * of the first MaximumNerveReadings structures are published for the
+   * display side (GetLatestNerveReadings). Set while the loop is stopped.
+   */
+  void SetNerveMonitor(vtkVolumeCutNerveMonitor* monitor);
+  vtkVolumeCutNerveMonitor* GetNerveMonitor();
+  static constexpr int MaximumNerveReadings = 16;
   ///@}
 
   ///@{
@@ -201,6 +216,13 @@ public:
    * read the field's contact record while the loop writes it.
    */
   double GetLatestContactDepth() const;
+
+  /**
+   * The nerve monitor's readings of the latest tick (a
+   * vtkVolumeCutNerveMonitor::Reading each, up to capacity), lock-free:
+   * returns their number, -1 before any tick measured.
+   */
+  VTK_WRAPEXCLUDE int GetLatestNerveReadings(void* readings, int capacity) const;
 
   /**
    * Drain what the haptic thread reported since the last call (cut strokes,

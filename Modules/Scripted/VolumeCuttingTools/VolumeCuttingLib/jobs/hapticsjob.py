@@ -9,7 +9,11 @@ device goes through: the haptic loop on its own thread at 1 kHz, the force
 model on the CT's iso-surface minus the cut field, strokes cut into the cut
 node's field by the haptic thread, and, at display rate on this thread, the
 tool node moved and the cut node's events sent (``vtkSlicerVolumeCuttingHapticSession``).
-The forces felt are recorded too (``haptic_replay.vchr``).
+The forces felt are recorded too (``haptic_replay.vchr``), and so is the
+virtual nerve monitor on the protected structures (every tick measures it;
+the burr's positions of every tick, as the recorder kept them, give its
+readings at 1 kHz for ``nerve_monitor.png``: distance per structure over
+time over the threshold bands, whatever the display rate).
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ import vtk
 
 from ..config import toolconfig
 from ..cutting import recording
+from ..feedback import nervemonitor
 
 #: The tool the session drills with.
 BURR_PRESET = "Cutting burr 4 mm"
@@ -162,6 +167,11 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     events = {"cut_modified": 0}
     observer = cut_node.AddObserver(slicer.vtkMRMLVolumeCutNode.CutModifiedEvent,
                                     lambda caller, event: events.__setitem__("cut_modified", events["cut_modified"] + 1))
+    # The monitor's fields are built on the logic's worker; the replay starts once they are.
+    build_started = time.perf_counter()
+    monitor = nervemonitor.monitor_for(logic, cut_node)
+    monitor_build_s = time.perf_counter() - build_started
+    display_readings = nervemonitor.MonitorRecording(nervemonitor.thresholds(monitor) if monitor else {})
     started = time.perf_counter()
     if not session.Start(cut_node, replay):
         cut_node.RemoveObserver(observer)
@@ -174,6 +184,8 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
             if frame is None:
                 time.sleep(DISPLAY_PERIOD_S)
             session.Update()
+            if monitor is not None:
+                display_readings.add(time.perf_counter() - started, nervemonitor.readings(monitor))
             if frame is not None:
                 frame()
             frames += 1
@@ -184,7 +196,6 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         cut_node.RemoveObserver(observer)
     wall_s = time.perf_counter() - started
     replayed.WriteFile(str(out_dir / "haptic_replay.vchr"))
-
     magnitudes = []
     proxies = []
     drilling = []
@@ -199,6 +210,21 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     magnitudes = np.array(magnitudes)
     drilling = np.array(drilling, dtype=bool)
     proxies = np.array(proxies)
+    nerve_monitor = {"monitored": 0}
+    if monitor is not None:
+        # The ticks measured the burr at its proxy: the same fields at the same positions give their readings.
+        ticks_recording = nervemonitor.recording_along(monitor, proxies, tool.GetCuttingRadius(), 1.0 / RATE_HZ)
+        nerve_monitor = {
+            "monitored": monitor.GetNumberOfStructures(),
+            "fields_build_s": round(monitor_build_s, 3),
+            "fields_memory_mib": round(monitor.GetMemorySize() / 2**20, 1),
+            "plot": str(ticks_recording.plot(out_dir / "nerve_monitor.png",
+                                             title="Virtual nerve monitor during the haptic replay (every tick)",
+                                             exact_below_mm=monitor.GetRange() - tool.GetCuttingRadius())),
+            "table_rows": logic.GetNerveMonitorTableNode(cut_node).GetTable().GetNumberOfRows(),
+            "display_updates": display_readings.summary()["samples"],
+            **ticks_recording.summary(),
+        }
     # How deep the burr's centre went past the surface it started from.
     deepest = float(np.max((proxies - surface) @ direction)) if len(proxies) else 0.0
     parameters = toolconfig.from_tool_node(tool)
@@ -246,5 +272,6 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "ticks_building_shield": int(loop.GetNumberOfTicksBuildingShield()),
         "tick_us_max_building_shield": round(loop.GetMaximumTickDurationBuildingShield(), 1),
         "real_time_priority": bool(loop.GetRealTimePriority()),
+        "nerve_monitor": nerve_monitor,
         "wall_s": round(wall_s, 2),
     }

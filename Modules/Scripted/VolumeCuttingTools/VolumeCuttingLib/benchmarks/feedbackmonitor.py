@@ -1,0 +1,192 @@
+"""The virtual nerve monitor's figures (issue 25), for the area ``feedback``.
+
+Accuracy: an analytic nerve, a cylinder of 0.7 mm radius along an oblique
+axis, rasterised at 0.15 mm (the temporal-bone scale) into a binary label;
+burrs of 0.5, 1 and 2 mm radius at 0.05 to 3.5 mm from its surface around
+its middle. The monitor's distance (field at the burr's centre minus the
+radius) against the exact one; baseline: the distance to the label's voxel
+cubes (the stairs a monitor without the smoothed surface reads), measured
+on the same burrs in the same process.
+
+Cost: the temporal-bone case (``data.temporalbone``: 288^3 voxels of
+0.15 mm, 14 structures drawn slice by slice), 10 of its structures
+monitored (the protected ones first). The build of the fields (the first
+call: all of them, as the logic's worker builds them; and the longest one
+structure took); one query of all 10 for a burr of 2 mm at 2000 positions
+around the middle of the case, each timed in C++ (p50, p99, max), against
+the brute-force distance from the burr to the 10 structures' surface voxels
+(numpy, the baseline) on the first positions. One core, this machine.
+
+``monitor_measurements(repeats)`` returns the harness's measurements; the
+lead combines them with the sound's figures into the area ``feedback``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import slicer
+import vtk
+from vtkmodules.util import numpy_support
+
+from ..data import temporalbone
+from .harness import machine_description, measurement
+
+CYLINDER_RADIUS = 0.7
+CYLINDER_SPACING = 0.15
+CYLINDER_EXTENT = 16.0
+BURR_RADII = (0.5, 1.0, 2.0)
+DISTANCES = (0.05, 0.3, 1.0, 1.5, 2.5, 3.5)
+MONITORED = 10
+QUERIES = 2000
+BRUTE_FORCE_QUERIES = 40
+BURR = 2.0
+
+
+def _label_image(labels: np.ndarray):
+    """A vtkImageData of a [k, j, i] label array (its IJK geometry is the monitor's to give)."""
+    image = vtk.vtkImageData()
+    image.SetDimensions(labels.shape[2], labels.shape[1], labels.shape[0])
+    scalars = numpy_support.numpy_to_vtk(np.ascontiguousarray(labels, dtype=np.uint16).ravel(), deep=1,
+                                         array_type=vtk.VTK_UNSIGNED_SHORT)
+    image.GetPointData().SetScalars(scalars)
+    return image
+
+
+def _matrix(array: np.ndarray):
+    matrix = vtk.vtkMatrix4x4()
+    for row in range(4):
+        for column in range(4):
+            matrix.SetElement(row, column, float(array[row, column]))
+    return matrix
+
+
+def _voxel_cube_distance(centres_ras, voxels_ras, half):
+    """Distance (mm) from each centre to the union of axis-aligned cubes of half size ``half`` at ``voxels_ras``."""
+    result = []
+    for centre in centres_ras:
+        gap = np.maximum(np.abs(voxels_ras - centre) - half, 0.0)
+        result.append(float(np.sqrt((gap * gap).sum(axis=1)).min()))
+    return np.array(result)
+
+
+def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
+    n = int(CYLINDER_EXTENT / CYLINDER_SPACING)
+    ijk_to_ras = np.diag([CYLINDER_SPACING] * 3 + [1.0])
+    centre = np.full(3, (n - 1) / 2 * CYLINDER_SPACING)
+    axis = np.array([0.7, -0.4, 0.59])
+    axis /= np.linalg.norm(axis)
+    k, j, i = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
+    points = np.stack([i, j, k], axis=-1) * CYLINDER_SPACING - centre
+    radial = points - (points @ axis)[..., None] * axis
+    labels = (np.linalg.norm(radial, axis=-1) <= CYLINDER_RADIUS).astype(np.uint16)
+    monitor = slicer.vtkVolumeCutNerveMonitor()
+    monitor.SetGeometry([n, n, n], _matrix(ijk_to_ras))
+    monitor.AddStructure("cylinder nerve", _label_image(labels), 1)
+    monitor.Build()
+
+    rng = np.random.default_rng(25)
+    count = 60 * max(1, repeats)
+    centres, exact, radii = [], [], []
+    for q in range(count):
+        distance = DISTANCES[q % len(DISTANCES)]
+        burr = BURR_RADII[(q // len(DISTANCES)) % len(BURR_RADII)]
+        normal = rng.normal(size=3)
+        normal -= (normal @ axis) * axis
+        normal /= np.linalg.norm(normal)
+        centres.append(centre + rng.uniform(-2.0, 2.0) * axis + (CYLINDER_RADIUS + burr + distance) * normal)
+        exact.append(distance)
+        radii.append(burr)
+    measured = []
+    for point, burr in zip(centres, radii):
+        monitor.UpdateWithBurr([float(v) for v in point], burr)
+        measured.append(monitor.GetDistance(0))
+    error = np.abs(np.array(measured) - np.array(exact))
+    voxel_centres = np.argwhere(labels[:, :, :] > 0)[:, ::-1] * CYLINDER_SPACING
+    stairs = _voxel_cube_distance(np.array(centres), voxel_centres, CYLINDER_SPACING / 2) - np.array(radii)
+    stairs_error = np.abs(stairs - np.array(exact))
+    where = f"cylinder nerve r {CYLINDER_RADIUS} mm at {CYLINDER_SPACING} mm voxels, {count} burrs of 0.5-2 mm at 0.05-3.5 mm"
+    return [
+        measurement(f"nerve monitor distance error, max ({where})", float(error.max()), "mm",
+                    "distance to the label's voxel cubes, max error", float(stairs_error.max()), count, machine),
+        measurement(f"nerve monitor distance error, mean ({where})", float(error.mean()), "mm",
+                    "distance to the label's voxel cubes, mean error", float(stairs_error.mean()), count, machine),
+    ]
+
+
+def _temporal_bone_cost(machine) -> list[dict]:
+    paths = temporalbone.cached_case_files()
+    reader = vtk.vtkNrrdReader()
+    reader.SetFileName(str(paths["labels"]))
+    reader.Update()
+    image = vtk.vtkImageData()
+    image.DeepCopy(reader.GetOutput())
+    image.SetOrigin(0, 0, 0)
+    image.SetSpacing(1, 1, 1)
+    dims = image.GetDimensions()
+    ijk_to_ras = temporalbone.ijk_to_ras_matrix(dims)
+    table = temporalbone.structures()
+    _, protected = temporalbone.roles(table)
+    order = [name for name in protected] + [s.name for s in table if s.name not in protected]
+    labels_of = {s.name: label for label, s in enumerate(table, start=1)}
+    chosen = order[:MONITORED]
+
+    monitor = slicer.vtkVolumeCutNerveMonitor()
+    monitor.SetGeometry(list(dims), _matrix(ijk_to_ras))
+    for name in chosen:
+        if monitor.AddStructure(name, image, labels_of[name]) < 0:
+            raise RuntimeError(f"the temporal-bone structure {name} could not be monitored (see the log)")
+    started = time.perf_counter()
+    monitor.Build()
+    build_s = time.perf_counter() - started
+
+    rng = np.random.default_rng(10)
+    middle = (ijk_to_ras @ np.array([(dims[0] - 1) / 2, (dims[1] - 1) / 2, (dims[2] - 1) / 2, 1.0]))[:3]
+    centres = middle + rng.uniform(-12.0, 12.0, size=(QUERIES, 3))
+    points = vtk.vtkPoints()
+    for centre in centres:
+        points.InsertNextPoint(*centre)
+    distances = vtk.vtkDoubleArray()
+    microseconds = vtk.vtkDoubleArray()
+    monitor.MeasureAlong(points, BURR, distances, microseconds)  # warm
+    monitor.MeasureAlong(points, BURR, distances, microseconds)
+    times = numpy_support.vtk_to_numpy(microseconds)
+
+    # Baseline: the exact distance to the structures' surface voxels, brute force.
+    labels = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(dims[2], dims[1], dims[0])
+    surfaces = []
+    for name in chosen:
+        mask = labels == labels_of[name]
+        inner = mask.copy()
+        for shift in ((1, 0), (-1, 0), (1, 1), (-1, 1), (1, 2), (-1, 2)):
+            inner &= np.roll(mask, shift[0], axis=shift[1])
+        surface = np.argwhere(mask & ~inner)[:, ::-1]
+        surfaces.append((ijk_to_ras[:3, :3] @ surface.T).T + ijk_to_ras[:3, 3])
+    brute = []
+    for centre in centres[:BRUTE_FORCE_QUERIES]:
+        started = time.perf_counter()
+        for surface in surfaces:
+            float(np.sqrt(((surface - centre) ** 2).sum(axis=1)).min()) - BURR
+        brute.append((time.perf_counter() - started) * 1e6)
+    brute_p50 = float(np.percentile(brute, 50))
+    where = f"{MONITORED} temporal-bone structures, 288^3 voxels of 0.15 mm, burr {BURR} mm"
+    structures = len(chosen)
+    return [
+        measurement(f"nerve monitor query of all {structures} structures, p50 ({where})", float(np.percentile(times, 50)), "us",
+                    "brute-force distance to their surface voxels (numpy), p50", brute_p50, QUERIES, machine),
+        measurement(f"nerve monitor query of all {structures} structures, p99 ({where})", float(np.percentile(times, 99)), "us",
+                    "brute-force distance to their surface voxels (numpy), p50", brute_p50, QUERIES, machine),
+        measurement(f"nerve monitor query of all {structures} structures, max ({where})", float(times.max()), "us",
+                    "brute-force distance to their surface voxels (numpy), max", float(np.max(brute)), QUERIES, machine),
+        measurement(f"nerve monitor fields build, first call: all {structures} structures ({where})", build_s, "s",
+                    "the longest one structure took", monitor.GetLastMaximumStructureBuildTime(), 1, machine),
+        measurement(f"nerve monitor fields memory ({where})", monitor.GetMemorySize() / 2**20, "MiB",
+                    "the label image", image.GetActualMemorySize() / 1024.0, 1, machine),
+    ]
+
+
+def monitor_measurements(repeats: int) -> list[dict]:
+    """The monitor's accuracy against an analytic nerve and its cost per tick on the temporal-bone case."""
+    machine = machine_description()
+    return _cylinder_accuracy(machine, repeats) + _temporal_bone_cost(machine)

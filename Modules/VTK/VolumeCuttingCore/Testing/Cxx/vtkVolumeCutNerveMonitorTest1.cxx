@@ -1,0 +1,602 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutCylinderTool.h"
+#include "vtkVolumeCutEllipsoidTool.h"
+#include "vtkVolumeCutLabelSurface.h"
+#include "vtkVolumeCutNerveMonitor.h"
+
+#include <vtkAddonTestingMacros.h>
+#include <vtkTestingOutputWindow.h>
+
+#include <vtkCallbackCommand.h>
+#include <vtkImageData.h>
+#include <vtkMath.h>
+#include <vtkMatrix4x4.h>
+#include <vtkMinimalStandardRandomSequence.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkTransform.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+namespace
+{
+using Reading = vtkVolumeCutNerveMonitor::Reading;
+
+/// An anatomy grid: dimensions, and IJK-to-RAS with the given spacing, turned about an oblique axis and moved.
+struct Grid
+{
+  int Dimensions[3];
+  vtkNew<vtkMatrix4x4> IJKToRAS;
+
+  Grid(const int dims[3], const double spacing[3], double turnDegrees)
+  {
+    std::copy(dims, dims + 3, this->Dimensions);
+    vtkNew<vtkTransform> transform;
+    transform->Translate(-12.0, 30.0, 5.0);
+    transform->RotateWXYZ(turnDegrees, 0.3, -0.5, 0.8);
+    transform->Scale(spacing);
+    this->IJKToRAS->DeepCopy(transform->GetMatrix());
+  }
+  void ToRAS(const double ijk[3], double ras[3]) const
+  {
+    const double in[4] = { ijk[0], ijk[1], ijk[2], 1.0 };
+    double out[4];
+    this->IJKToRAS->MultiplyPoint(in, out);
+    std::copy(out, out + 3, ras);
+  }
+  /// The centre of the grid in RAS.
+  void Centre(double ras[3]) const
+  {
+    const double ijk[3] = { 0.5 * (this->Dimensions[0] - 1), 0.5 * (this->Dimensions[1] - 1), 0.5 * (this->Dimensions[2] - 1) };
+    this->ToRAS(ijk, ras);
+  }
+  /// A label image with value where inside(ras) holds at the voxel centre.
+  vtkSmartPointer<vtkImageData> Rasterise(const std::function<bool(const double*)>& inside, int value) const
+  {
+    auto labels = vtkSmartPointer<vtkImageData>::New();
+    labels->SetDimensions(this->Dimensions[0], this->Dimensions[1], this->Dimensions[2]);
+    labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
+    unsigned short* voxel = static_cast<unsigned short*>(labels->GetScalarPointer());
+    for (int k = 0; k < this->Dimensions[2]; ++k)
+    {
+      for (int j = 0; j < this->Dimensions[1]; ++j)
+      {
+        for (int i = 0; i < this->Dimensions[0]; ++i, ++voxel)
+        {
+          const double ijk[3] = { double(i), double(j), double(k) };
+          double ras[3];
+          this->ToRAS(ijk, ras);
+          *voxel = inside(ras) ? static_cast<unsigned short>(value) : 0;
+        }
+      }
+    }
+    return labels;
+  }
+};
+
+/// An analytic nerve: a cylinder (infinite along its axis) of radius R about a line.
+struct Cylinder
+{
+  double Point[3];
+  double Axis[3];
+  double Radius;
+  double SurfaceDistance(const double p[3]) const
+  {
+    double d[3] = { p[0] - this->Point[0], p[1] - this->Point[1], p[2] - this->Point[2] };
+    const double along = vtkMath::Dot(d, this->Axis);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      d[axis] -= along * this->Axis[axis];
+    }
+    return vtkMath::Norm(d) - this->Radius;
+  }
+};
+
+/// Points on a structure's smoothed surface (RAS), independently of the
+/// monitor: the zero set of the trilinear levels crossed along the edges of
+/// a grid refine times finer than the voxels.
+std::vector<double> SmoothedSurfacePoints(const Grid& grid, vtkImageData* labels, int value, double smoothing, int refine)
+{
+  const int* dims = grid.Dimensions;
+  const unsigned short* voxels = static_cast<const unsigned short*>(labels->GetScalarPointer());
+  std::vector<uint16_t> mask(voxels, voxels + static_cast<size_t>(dims[0]) * dims[1] * dims[2]);
+  std::vector<std::vector<int>> boxes;
+  vtkVolumeCutLabelSurface::ComputeLabelBoxes(mask.data(), dims, { value }, boxes);
+  double spacing[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    spacing[axis] = std::sqrt(grid.IJKToRAS->GetElement(0, axis) * grid.IJKToRAS->GetElement(0, axis) + grid.IJKToRAS->GetElement(1, axis) * grid.IJKToRAS->GetElement(1, axis) +
+      grid.IJKToRAS->GetElement(2, axis) * grid.IJKToRAS->GetElement(2, axis));
+  }
+  vtkVolumeCutLabelSurface::Levels levels;
+  vtkVolumeCutLabelSurface::Initialize(dims, spacing, boxes[0].data(), smoothing, levels);
+  vtkVolumeCutLabelSurface::ComputeSlices(mask.data(), dims, spacing, value, boxes[0].data(), smoothing, 0,
+    vtkVolumeCutLabelSurface::GetNumberOfSlices(boxes[0].data(), levels), levels);
+  vtkVolumeCutLabelSurface::ExtrapolateEnds(boxes[0].data(), levels);
+  const int* box = levels.Box;
+  const int n[3] = { box[1] - box[0] + 1, box[3] - box[2] + 1, box[5] - box[4] + 1 };
+  auto level = [&](const double ijk[3]) {
+    int cell[3];
+    double t[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double local = std::min(std::max(ijk[axis] - box[2 * axis], 0.0), n[axis] - 1.0);
+      cell[axis] = std::min(static_cast<int>(local), std::max(n[axis] - 2, 0));
+      t[axis] = local - cell[axis];
+    }
+    double value = 0.0;
+    for (int c = 0; c < 8; ++c)
+    {
+      const int a = c & 1, b = (c >> 1) & 1, d = (c >> 2) & 1;
+      const double weight = (a ? t[0] : 1 - t[0]) * (b ? t[1] : 1 - t[1]) * (d ? t[2] : 1 - t[2]);
+      const int i = std::min(cell[0] + a, n[0] - 1), j = std::min(cell[1] + b, n[1] - 1), k = std::min(cell[2] + d, n[2] - 1);
+      value += weight * levels.Values[i + static_cast<size_t>(n[0]) * (j + static_cast<size_t>(n[1]) * k)];
+    }
+    return value;
+  };
+  std::vector<double> points;
+  const double step = 1.0 / refine;
+  for (int k = 0; k < (n[2] - 1) * refine; ++k)
+  {
+    for (int j = 0; j < (n[1] - 1) * refine; ++j)
+    {
+      for (int i = 0; i < (n[0] - 1) * refine; ++i)
+      {
+        const double ijk[3] = { box[0] + i * step, box[2] + j * step, box[4] + k * step };
+        const double g0 = level(ijk);
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          double next[3] = { ijk[0], ijk[1], ijk[2] };
+          next[axis] += step;
+          const double g1 = level(next);
+          if ((g0 <= 0.0) != (g1 <= 0.0))
+          {
+            double crossing[3] = { ijk[0], ijk[1], ijk[2] };
+            crossing[axis] += step * g0 / (g0 - g1);
+            double ras[3];
+            grid.ToRAS(crossing, ras);
+            points.insert(points.end(), ras, ras + 3);
+          }
+        }
+      }
+    }
+  }
+  return points;
+}
+
+double NearestDistance(const std::vector<double>& points, const double p[3])
+{
+  double best = 1e300;
+  for (size_t n = 0; n < points.size(); n += 3)
+  {
+    best = std::min(best, vtkMath::Distance2BetweenPoints(p, points.data() + n));
+  }
+  return std::sqrt(best);
+}
+
+double Random(vtkMinimalStandardRandomSequence* random, double low, double high)
+{
+  random->Next();
+  return random->GetRangeValue(low, high);
+}
+
+/// A random unit vector.
+void RandomDirection(vtkMinimalStandardRandomSequence* random, double direction[3])
+{
+  do
+  {
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      direction[axis] = Random(random, -1.0, 1.0);
+    }
+  } while (vtkMath::Norm(direction) > 1.0 || vtkMath::Norm(direction) < 0.1);
+  vtkMath::Normalize(direction);
+}
+
+/// Largest error of the burr's distance against the cylinder over burrs at
+/// several distances and radii around its middle (away from the grid's ends).
+double CylinderError(const double spacing[3], double turnDegrees, double radius, int positions, double& worstAt)
+{
+  const double extent = 18.0; // mm
+  const int dims[3] = { int(extent / spacing[0]), int(extent / spacing[1]), int(extent / spacing[2]) };
+  Grid grid(dims, spacing, turnDegrees);
+  Cylinder nerve;
+  grid.Centre(nerve.Point);
+  nerve.Axis[0] = 0.7;
+  nerve.Axis[1] = -0.4;
+  nerve.Axis[2] = 0.59;
+  vtkMath::Normalize(nerve.Axis);
+  nerve.Radius = radius;
+  auto labels = grid.Rasterise([&](const double* p) { return nerve.SurfaceDistance(p) <= 0.0; }, 7);
+  vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
+  if (monitor->AddStructure("facial nerve", labels, 7) != 0 || monitor->Build() != 1)
+  {
+    return 1e9;
+  }
+  vtkNew<vtkMinimalStandardRandomSequence> random;
+  random->SetSeed(25);
+  const double distances[] = { 0.05, 0.3, 1.0, 1.5, 2.5, 3.5 };
+  const double burrRadii[] = { 0.5, 1.0, 2.0 };
+  double worst = 0.0;
+  for (int n = 0; n < positions; ++n)
+  {
+    const double distance = distances[n % 6];
+    const double burr = burrRadii[(n / 6) % 3];
+    // A point on the axis within 2 mm of the middle, then out along a random normal.
+    double normal[3];
+    RandomDirection(random, normal);
+    const double along = vtkMath::Dot(normal, nerve.Axis);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      normal[axis] -= along * nerve.Axis[axis];
+    }
+    vtkMath::Normalize(normal);
+    const double s = Random(random, -2.0, 2.0);
+    double centre[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      centre[axis] = nerve.Point[axis] + s * nerve.Axis[axis] + (radius + burr + distance) * normal[axis];
+    }
+    Reading reading;
+    monitor->Measure(centre, burr, &reading, 1);
+    const double error = std::abs(reading.Distance - distance);
+    if (error > worst)
+    {
+      worst = error;
+      worstAt = distance;
+    }
+  }
+  return worst;
+}
+
+int TestCylinderAccuracy()
+{
+  struct Case
+  {
+    double Spacing[3];
+    double Turn;
+    double Radius;
+    double Bound;
+  };
+  // Temporal-bone voxels (0.15 mm), straight and oblique grids: within the
+  // issue's 0.05 mm. On anisotropic voxels the smoothed surface drawn from
+  // the binary label itself departs further from the cylinder (a quarter of
+  // the slice spacing): the field's own error is tested against that surface
+  // (TestSphereAccuracyAndTools).
+  const Case cases[] = { { { 0.15, 0.15, 0.15 }, 0.0, 0.8, 0.05 }, { { 0.15, 0.15, 0.15 }, 33.0, 0.6, 0.05 },
+    { { 0.12, 0.15, 0.25 }, 20.0, 1.0, 0.0625 }, { { 0.2, 0.2, 0.4 }, 0.0, 1.5, 0.1 } };
+  for (const Case& c : cases)
+  {
+    double worstAt = 0.0;
+    const double error = CylinderError(c.Spacing, c.Turn, c.Radius, 360, worstAt);
+    std::cout << "cylinder radius " << c.Radius << " mm, spacing " << c.Spacing[0] << " x " << c.Spacing[1] << " x " << c.Spacing[2]
+              << " mm, grid turned " << c.Turn << " degrees: max error " << error << " mm (at " << worstAt << " mm)" << std::endl;
+    CHECK_BOOL(error <= c.Bound, true);
+  }
+  return EXIT_SUCCESS;
+}
+
+int TestSphereAccuracyAndTools()
+{
+  const double spacing[3] = { 0.15, 0.18, 0.22 };
+  const int dims[3] = { 130, 110, 90 }; // about 20 mm across: every burr below stays inside
+  Grid grid(dims, spacing, 15.0);
+  double centre[3];
+  grid.Centre(centre);
+  const double radius = 1.5;
+  auto labels = grid.Rasterise([&](const double* p) { return std::sqrt(vtkMath::Distance2BetweenPoints(p, centre)) <= radius; }, 3);
+  vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  CHECK_BOOL(monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS), true);
+  CHECK_INT(monitor->AddStructure("vestibule", labels, 3), 0);
+  // Before Build: not ready, never a guess.
+  Reading reading;
+  CHECK_INT(monitor->Measure(centre, 1.0, &reading, 1), 1);
+  CHECK_INT(reading.Level, vtkVolumeCutNerveMonitor::NotReady);
+  CHECK_BOOL(std::isnan(reading.Distance), true);
+  CHECK_INT(monitor->Build(), 1);
+  CHECK_BOOL(monitor->IsBuilt(), true);
+
+  vtkNew<vtkMinimalStandardRandomSequence> random;
+  random->SetSeed(3);
+  double worst = 0.0;
+  for (int n = 0; n < 400; ++n)
+  {
+    double direction[3];
+    RandomDirection(random, direction);
+    const double distance = Random(random, 0.02, 3.5);
+    const double burr = Random(random, 0.5, 2.0);
+    double p[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      p[axis] = centre[axis] + (radius + burr + distance) * direction[axis];
+    }
+    monitor->Measure(p, burr, &reading, 1);
+    worst = std::max(worst, std::abs(reading.Distance - distance));
+  }
+  std::cout << "sphere radius 1.5 mm, spacing 0.15 x 0.18 x 0.22 mm: max error " << worst << " mm" << std::endl;
+  // From voxels this size the smoothed surface itself departs from the
+  // sphere by up to about 0.06 mm (in-slice Gaussian and slice interpolation);
+  // against that surface, found independently, the field is far closer.
+  CHECK_BOOL(worst <= 0.075, true);
+  const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 6);
+  double worstOwn = 0.0;
+  for (int n = 0; n < 120; ++n)
+  {
+    double direction[3];
+    RandomDirection(random, direction);
+    const double burr = Random(random, 0.5, 2.0);
+    const double distance = Random(random, 0.0, 3.5);
+    double p[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      p[axis] = centre[axis] + (radius + burr + distance) * direction[axis];
+    }
+    monitor->Measure(p, burr, &reading, 1);
+    worstOwn = std::max(worstOwn, std::abs(reading.Distance - (NearestDistance(surface, p) - burr)));
+  }
+  std::cout << "against the smoothed surface itself (" << surface.size() / 3 << " points): max error " << worstOwn << " mm" << std::endl;
+  CHECK_BOOL(worstOwn <= 0.02, true);
+
+  // Any tool: a sphere given as an ellipsoid reads as the burr does; a
+  // cylinder burr against its exact distance to the sphere.
+  vtkNew<vtkVolumeCutEllipsoidTool> ball;
+  ball->SetRadii(1.2, 1.2, 1.2);
+  vtkNew<vtkVolumeCutCylinderTool> cylinder;
+  cylinder->SetRadius(0.8);
+  cylinder->SetLength(4.0);
+  double worstBall = 0.0, worstCylinder = 0.0;
+  for (int n = 0; n < 60; ++n)
+  {
+    double direction[3];
+    RandomDirection(random, direction);
+    const double distance = Random(random, 0.1, 3.0);
+    vtkNew<vtkTransform> pose;
+    pose->Translate(centre[0] + (radius + 1.2 + distance) * direction[0], centre[1] + (radius + 1.2 + distance) * direction[1],
+      centre[2] + (radius + 1.2 + distance) * direction[2]);
+    pose->RotateWXYZ(Random(random, 0.0, 180.0), 0.2, 0.9, -0.4);
+    CHECK_BOOL(monitor->UpdateWithTool(ball, pose->GetMatrix()), true);
+    const double* position = pose->GetPosition();
+    monitor->Measure(position, 1.2, &reading, 1);
+    worstBall = std::max(worstBall, std::abs(monitor->GetDistance(0) - reading.Distance));
+    // The cylinder at a random pose: its exact distance to the sphere's centre, less the radius.
+    vtkNew<vtkMatrix4x4> rasToTool;
+    vtkMatrix4x4::Invert(pose->GetMatrix(), rasToTool);
+    const double in[4] = { centre[0], centre[1], centre[2], 1.0 };
+    double local[4];
+    rasToTool->MultiplyPoint(in, local);
+    const double radial = std::max(0.0, std::hypot(local[0], local[1]) - 0.8);
+    const double axial = std::max(0.0, std::abs(local[2]) - 2.0);
+    const double exact = std::hypot(radial, axial) - radius;
+    CHECK_BOOL(monitor->UpdateWithTool(cylinder, pose->GetMatrix()), true);
+    if (exact < 4.0)
+    {
+      worstCylinder = std::max(worstCylinder, std::abs(monitor->GetDistance(0) - exact));
+    }
+  }
+  std::cout << "tools on " << monitor->GetNumberOfToolSamples() << " surface points: ellipsoid ball against the burr max difference " << worstBall
+            << " mm, cylinder burr " << worstCylinder << " mm" << std::endl;
+  CHECK_BOOL(worstBall <= 0.025, true); // points 0.2 mm apart on the ball
+  CHECK_BOOL(worstCylinder <= 0.08, true);
+  return EXIT_SUCCESS;
+}
+
+/// Levels at each threshold, the firing rate, and the events.
+int TestLevelsAndEvents()
+{
+  vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  struct Expected
+  {
+    double Distance;
+    int Level;
+  };
+  const Expected expected[] = { { 10.0, vtkVolumeCutNerveMonitor::Silent }, { 4.001, vtkVolumeCutNerveMonitor::Silent },
+    { 4.0, vtkVolumeCutNerveMonitor::SparseClicks }, { 2.001, vtkVolumeCutNerveMonitor::SparseClicks }, { 2.0, vtkVolumeCutNerveMonitor::Bursts },
+    { 1.001, vtkVolumeCutNerveMonitor::Bursts }, { 1.0, vtkVolumeCutNerveMonitor::Continuous }, { 0.001, vtkVolumeCutNerveMonitor::Continuous },
+    { 0.0, vtkVolumeCutNerveMonitor::Contact }, { -0.5, vtkVolumeCutNerveMonitor::Contact } };
+  double previousRate = -1.0;
+  for (const Expected& e : expected)
+  {
+    CHECK_INT(monitor->GetLevelOfDistance(e.Distance), e.Level);
+    const double rate = monitor->GetFiringRateOfDistance(e.Distance);
+    CHECK_BOOL(rate >= previousRate, true); // rises with proximity
+    previousRate = rate;
+  }
+  CHECK_DOUBLE(monitor->GetFiringRateOfDistance(4.5), 0.0);
+  CHECK_DOUBLE(monitor->GetFiringRateOfDistance(0.0), 200.0);
+  CHECK_DOUBLE(monitor->GetFiringRateOfDistance(2.0), 50.0);
+
+  CHECK_BOOL(monitor->SetThresholds(6.0, 3.0, 1.5), true);
+  CHECK_INT(monitor->GetLevelOfDistance(5.0), vtkVolumeCutNerveMonitor::SparseClicks);
+  CHECK_INT(monitor->GetLevelOfDistance(2.5), vtkVolumeCutNerveMonitor::Bursts);
+  CHECK_INT(monitor->GetLevelOfDistance(1.2), vtkVolumeCutNerveMonitor::Continuous);
+  CHECK_BOOL(monitor->SetThresholds(4.0, 2.0, 1.0), true);
+
+  // A burr approaching a sphere: readings cross every threshold, one event per change of level.
+  const double spacing[3] = { 0.2, 0.2, 0.2 };
+  const int dims[3] = { 80, 80, 80 };
+  Grid grid(dims, spacing, 0.0);
+  double centre[3];
+  grid.Centre(centre);
+  auto labels = grid.Rasterise([&](const double* p) { return std::sqrt(vtkMath::Distance2BetweenPoints(p, centre)) <= 1.0; }, 1);
+  monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
+  CHECK_INT(monitor->AddStructure("nerve", labels, 1), 0);
+  monitor->Build();
+  int levelEvents = 0;
+  vtkNew<vtkCallbackCommand> counter;
+  counter->SetClientData(&levelEvents);
+  counter->SetCallback([](vtkObject*, unsigned long, void* clientData, void*) { ++*static_cast<int*>(clientData); });
+  monitor->AddObserver(vtkVolumeCutNerveMonitor::LevelChangedEvent, counter);
+  const double burr = 1.0;
+  int lastLevel = vtkVolumeCutNerveMonitor::NotReady;
+  int changes = 0;
+  const double steps[] = { 6.0, 5.0, 3.9, 3.0, 2.1, 1.9, 1.5, 1.1, 0.9, 0.5, 0.1, -0.1, -0.3 };
+  for (double distance : steps)
+  {
+    const double p[3] = { centre[0] + 1.0 + burr + distance, centre[1], centre[2] };
+    monitor->UpdateWithBurr(p, burr);
+    changes += monitor->GetLevel(0) != lastLevel ? 1 : 0;
+    lastLevel = monitor->GetLevel(0);
+    CHECK_INT(monitor->GetLevel(0), monitor->GetLevelOfDistance(distance));
+  }
+  CHECK_INT(lastLevel, vtkVolumeCutNerveMonitor::Contact);
+  CHECK_INT(changes, 5); // not ready -> silent -> sparse clicks -> bursts -> continuous -> contact
+  CHECK_INT(levelEvents, changes);
+  CHECK_INT(monitor->GetNumberOfLevelChanges(), changes);
+  CHECK_INT(monitor->GetHighestLevel(), vtkVolumeCutNerveMonitor::Contact);
+  // Beyond the range: a lower bound, silent.
+  const double far[3] = { centre[0] + 40.0, centre[1], centre[2] };
+  Reading reading;
+  monitor->Measure(far, 1.0, &reading, 1);
+  CHECK_BOOL(reading.Distance >= monitor->GetRange() - 1.0, true);
+  CHECK_INT(reading.Level, vtkVolumeCutNerveMonitor::Silent);
+  return EXIT_SUCCESS;
+}
+
+int TestBadInput()
+{
+  vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  const double spacing[3] = { 0.5, 0.5, 0.5 };
+  const int dims[3] = { 20, 20, 20 };
+  Grid grid(dims, spacing, 0.0);
+  auto empty = grid.Rasterise([](const double*) { return false; }, 1);
+  auto some = grid.Rasterise([](const double*) { return true; }, 1);
+
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_INT(monitor->AddStructure("facial nerve", some, 1), -1); // no geometry yet
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+
+  // Skewed axes (a gantry tilt) are refused; a turned orthogonal grid is not.
+  vtkNew<vtkMatrix4x4> sheared;
+  sheared->DeepCopy(grid.IJKToRAS);
+  sheared->SetElement(0, 2, 0.2);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(monitor->SetGeometry(dims, sheared), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_BOOL(monitor->SetGeometry(dims, grid.IJKToRAS), true);
+
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_INT(monitor->AddStructure("chorda tympani", empty, 1), -1);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  // A structure outside the scan: its voxels lie beyond the anatomy's.
+  auto outside = grid.Rasterise([](const double*) { return true; }, 1);
+  outside->SetExtent(40, 59, 0, 19, 0, 19);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_INT(monitor->AddStructure("sigmoid sinus", outside, 1), -1);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_INT(monitor->GetNumberOfStructures(), 0);
+
+  CHECK_INT(monitor->AddStructure("facial nerve", some, 1), 0);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_INT(monitor->AddStructure("facial nerve", some, 1), -1); // name used
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+
+  // Thresholds out of order: refused, the old ones kept.
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(monitor->SetThresholds(2.0, 4.0, 1.0), false);
+  CHECK_BOOL(monitor->SetThresholds(4.0, 2.0, 0.0), false);
+  CHECK_BOOL(monitor->SetThresholds(4.0, 2.0, 2.0), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_DOUBLE(monitor->GetSilentThreshold(), 4.0);
+  CHECK_DOUBLE(monitor->GetSparseThreshold(), 2.0);
+  CHECK_DOUBLE(monitor->GetBurstThreshold(), 1.0);
+
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(monitor->PrepareTool(nullptr), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  Reading reading;
+  CHECK_INT(monitor->MeasureTool(grid.IJKToRAS->GetData(), &reading, 1), -1);
+
+  std::ostringstream printed;
+  monitor->Print(printed);
+  CHECK_BOOL(printed.str().find("facial nerve") != std::string::npos, true);
+  return EXIT_SUCCESS;
+}
+
+/// Build on a worker while another thread measures without waiting; then the
+/// cost of a query of 10 structures (a benchmark: printed, not asserted).
+int TestThreadsAndCost()
+{
+  const double spacing[3] = { 0.15, 0.15, 0.15 };
+  const int dims[3] = { 120, 120, 90 };
+  Grid grid(dims, spacing, 10.0);
+  vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
+  double centre[3];
+  grid.Centre(centre);
+  std::vector<Cylinder> nerves;
+  for (int n = 0; n < 10; ++n)
+  {
+    Cylinder nerve;
+    const double angle = 2.0 * vtkMath::Pi() * n / 10.0;
+    nerve.Point[0] = centre[0] + 4.0 * std::cos(angle);
+    nerve.Point[1] = centre[1] + 4.0 * std::sin(angle);
+    nerve.Point[2] = centre[2];
+    nerve.Axis[0] = std::sin(angle);
+    nerve.Axis[1] = 0.3;
+    nerve.Axis[2] = std::cos(angle);
+    vtkMath::Normalize(nerve.Axis);
+    nerve.Radius = 0.4 + 0.1 * n;
+    nerves.push_back(nerve);
+    auto labels = grid.Rasterise([&](const double* p) { return nerve.SurfaceDistance(p) <= 0.0; }, 1);
+    CHECK_INT(monitor->AddStructure(("nerve " + std::to_string(n)).c_str(), labels, 1), n);
+  }
+  std::atomic<bool> done{ false };
+  std::thread worker([&] {
+    monitor->Build();
+    done = true;
+  });
+  Reading readings[10];
+  long long measuredWhileBuilding = 0;
+  while (!done)
+  {
+    monitor->Measure(centre, 1.0, readings, 10);
+    ++measuredWhileBuilding;
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  worker.join();
+  CHECK_BOOL(monitor->IsBuilt(), true);
+  std::cout << "10 fields built on a worker in " << monitor->GetLastBuildTime() << " s (longest "
+            << monitor->GetLastMaximumStructureBuildTime() << " s), " << monitor->GetMemorySize() / 1048576.0 << " MiB; "
+            << measuredWhileBuilding << " measurements meanwhile" << std::endl;
+
+  vtkNew<vtkMinimalStandardRandomSequence> random;
+  random->SetSeed(10);
+  const int queries = 20000;
+  std::vector<double> positions(3 * queries);
+  for (double& value : positions)
+  {
+    value = Random(random, -5.0, 5.0);
+  }
+  std::vector<double> microseconds(queries);
+  for (int n = 0; n < queries; ++n)
+  {
+    const double p[3] = { centre[0] + positions[3 * n], centre[1] + positions[3 * n + 1], centre[2] + positions[3 * n + 2] };
+    const auto start = std::chrono::steady_clock::now();
+    monitor->Measure(p, 1.0, readings, 10);
+    microseconds[n] = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  }
+  std::sort(microseconds.begin(), microseconds.end());
+  std::cout << "query of 10 structures (burr): p50 " << microseconds[queries / 2] << " us, p99 " << microseconds[queries * 99 / 100]
+            << " us, max " << microseconds.back() << " us" << std::endl;
+  return EXIT_SUCCESS;
+}
+}
+
+int vtkVolumeCutNerveMonitorTest1(int, char*[])
+{
+  CHECK_EXIT_SUCCESS(TestLevelsAndEvents());
+  CHECK_EXIT_SUCCESS(TestBadInput());
+  CHECK_EXIT_SUCCESS(TestSphereAccuracyAndTools());
+  CHECK_EXIT_SUCCESS(TestCylinderAccuracy());
+  CHECK_EXIT_SUCCESS(TestThreadsAndCost());
+  return EXIT_SUCCESS;
+}

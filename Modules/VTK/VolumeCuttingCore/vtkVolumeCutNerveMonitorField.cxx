@@ -1,0 +1,394 @@
+// SPDX-FileCopyrightText: VolumeCutting developers
+// SPDX-License-Identifier: Apache-2.0
+#include "vtkVolumeCutNerveMonitorField.h"
+
+#include "vtkSMPTools.h"
+#include "vtkVolumeCutLabelSurface.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace
+{
+/// Marks in the brick directory for bricks without samples.
+constexpr int32_t FarOutside = -1;
+constexpr int32_t DeepInside = -2;
+
+/// The smoothed levels on the whole mask grid, with the trilinear interpolation whose zero set is the surface.
+struct LevelGrid
+{
+  int Dims[3];
+  double Spacing[3];
+  std::vector<float> Values;
+
+  vtkIdType Index(int i, int j, int k) const { return i + static_cast<vtkIdType>(this->Dims[0]) * (j + static_cast<vtkIdType>(this->Dims[1]) * k); }
+
+  /// Level and its gradient (per mm) at a point (mm from the first voxel's centre).
+  double Evaluate(const double x[3], double gradient[3]) const
+  {
+    int cell[3];
+    double t[3];
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double index = std::min(std::max(x[axis] / this->Spacing[axis], 0.0), static_cast<double>(this->Dims[axis] - 1));
+      cell[axis] = std::min(static_cast<int>(index), std::max(this->Dims[axis] - 2, 0));
+      t[axis] = index - cell[axis];
+    }
+    double corner[2][2][2];
+    for (int c = 0; c < 8; ++c)
+    {
+      const int a = c & 1, b = (c >> 1) & 1, d = (c >> 2) & 1;
+      const int i = std::min(cell[0] + a, this->Dims[0] - 1);
+      const int j = std::min(cell[1] + b, this->Dims[1] - 1);
+      const int k = std::min(cell[2] + d, this->Dims[2] - 1);
+      corner[d][b][a] = this->Values[this->Index(i, j, k)];
+    }
+    const double x00 = corner[0][0][0] + t[0] * (corner[0][0][1] - corner[0][0][0]);
+    const double x10 = corner[0][1][0] + t[0] * (corner[0][1][1] - corner[0][1][0]);
+    const double x01 = corner[1][0][0] + t[0] * (corner[1][0][1] - corner[1][0][0]);
+    const double x11 = corner[1][1][0] + t[0] * (corner[1][1][1] - corner[1][1][0]);
+    const double y0 = x00 + t[1] * (x10 - x00);
+    const double y1 = x01 + t[1] * (x11 - x01);
+    const double dx0 = (1 - t[1]) * (corner[0][0][1] - corner[0][0][0]) + t[1] * (corner[0][1][1] - corner[0][1][0]);
+    const double dx1 = (1 - t[1]) * (corner[1][0][1] - corner[1][0][0]) + t[1] * (corner[1][1][1] - corner[1][1][0]);
+    gradient[0] = ((1 - t[2]) * dx0 + t[2] * dx1) / this->Spacing[0];
+    gradient[1] = ((1 - t[2]) * (x10 - x00) + t[2] * (x11 - x01)) / this->Spacing[1];
+    gradient[2] = (y1 - y0) / this->Spacing[2];
+    return y0 + t[2] * (y1 - y0);
+  }
+};
+
+/// Surface points, and for every voxel the index of the nearest one found so far.
+struct FootPoints
+{
+  std::vector<float> X, Y, Z;
+  std::vector<int32_t> Nearest;
+  std::vector<float> SquaredDistance;
+
+  int32_t Add(const double p[3])
+  {
+    this->X.push_back(static_cast<float>(p[0]));
+    this->Y.push_back(static_cast<float>(p[1]));
+    this->Z.push_back(static_cast<float>(p[2]));
+    return static_cast<int32_t>(this->X.size() - 1);
+  }
+  double SquaredDistanceTo(int32_t foot, const double p[3]) const
+  {
+    const double dx = p[0] - this->X[foot], dy = p[1] - this->Y[foot], dz = p[2] - this->Z[foot];
+    return dx * dx + dy * dy + dz * dz;
+  }
+  void Offer(vtkIdType voxel, int32_t foot, const double p[3])
+  {
+    const double d2 = this->SquaredDistanceTo(foot, p);
+    if (d2 < this->SquaredDistance[voxel])
+    {
+      this->SquaredDistance[voxel] = static_cast<float>(d2);
+      this->Nearest[voxel] = foot;
+    }
+  }
+};
+
+/// One raster sweep over the grid: each voxel takes the nearest of the foot
+/// points its already visited neighbours hold (forward: the 13 before it in
+/// memory order; backward: the 13 after it, visiting in reverse).
+void Sweep(const LevelGrid& grid, FootPoints& feet, bool forward)
+{
+  int offsets[13][3];
+  int n = 0;
+  for (int dk = -1; dk <= 1; ++dk)
+  {
+    for (int dj = -1; dj <= 1; ++dj)
+    {
+      for (int di = -1; di <= 1; ++di)
+      {
+        const int linear = di + 3 * (dj + 3 * dk);
+        if (forward ? linear < 0 : linear > 0)
+        {
+          offsets[n][0] = di;
+          offsets[n][1] = dj;
+          offsets[n][2] = dk;
+          ++n;
+        }
+      }
+    }
+  }
+  const int* dims = grid.Dims;
+  vtkIdType linear[13];
+  for (int n = 0; n < 13; ++n)
+  {
+    linear[n] = grid.Index(offsets[n][0], offsets[n][1], offsets[n][2]) - grid.Index(0, 0, 0);
+  }
+  const int step = forward ? 1 : -1;
+  for (int k = forward ? 0 : dims[2] - 1; k >= 0 && k < dims[2]; k += step)
+  {
+    for (int j = forward ? 0 : dims[1] - 1; j >= 0 && j < dims[1]; j += step)
+    {
+      const bool innerRow = k > 0 && j > 0 && k < dims[2] - 1 && j < dims[1] - 1;
+      for (int i = forward ? 0 : dims[0] - 1; i >= 0 && i < dims[0]; i += step)
+      {
+        const vtkIdType voxel = grid.Index(i, j, k);
+        const double p[3] = { i * grid.Spacing[0], j * grid.Spacing[1], k * grid.Spacing[2] };
+        if (innerRow && i > 0 && i < dims[0] - 1)
+        {
+          // Away from the grid's faces every neighbour exists: no bounds to check.
+          for (const vtkIdType offset : linear)
+          {
+            const int32_t foot = feet.Nearest[voxel + offset];
+            if (foot >= 0 && foot != feet.Nearest[voxel])
+            {
+              feet.Offer(voxel, foot, p);
+            }
+          }
+          continue;
+        }
+        for (const int* offset : offsets)
+        {
+          const int ni = i + offset[0], nj = j + offset[1], nk = k + offset[2];
+          if (ni < 0 || nj < 0 || nk < 0 || ni >= dims[0] || nj >= dims[1] || nk >= dims[2])
+          {
+            continue;
+          }
+          const int32_t foot = feet.Nearest[grid.Index(ni, nj, nk)];
+          if (foot >= 0 && foot != feet.Nearest[voxel])
+          {
+            feet.Offer(voxel, foot, p);
+          }
+        }
+      }
+    }
+  }
+}
+}
+
+//------------------------------------------------------------------------------
+std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorField::Build(const uint16_t* mask, const int dims[3],
+  const int origin[3], const double spacing[3], const int labelBox[6], double smoothing, double range)
+{
+  vtkVolumeCutLabelSurface::Levels levels;
+  if (!vtkVolumeCutLabelSurface::Initialize(dims, spacing, labelBox, smoothing, levels))
+  {
+    return nullptr;
+  }
+  vtkSMPTools::For(0, vtkVolumeCutLabelSurface::GetNumberOfSlices(labelBox, levels), [&](vtkIdType begin, vtkIdType end) {
+    vtkVolumeCutLabelSurface::ComputeSlices(mask, dims, spacing, 1, labelBox, smoothing, static_cast<int>(begin), static_cast<int>(end), levels);
+  });
+  vtkVolumeCutLabelSurface::ExtrapolateEnds(labelBox, levels);
+
+  LevelGrid grid;
+  std::copy(dims, dims + 3, grid.Dims);
+  std::copy(spacing, spacing + 3, grid.Spacing);
+  const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  grid.Values.assign(count, static_cast<float>(levels.Ramp));
+  const int* box = levels.Box;
+  const float* level = levels.Values.data();
+  for (int k = box[4]; k <= box[5]; ++k)
+  {
+    for (int j = box[2]; j <= box[3]; ++j)
+    {
+      std::copy(level, level + (box[1] - box[0] + 1), grid.Values.begin() + grid.Index(box[0], j, k));
+      level += box[1] - box[0] + 1;
+    }
+  }
+
+  // Foot points: where the zero set crosses the edges between voxel
+  // centres, and where Newton's iteration from the voxels on either side lands.
+  FootPoints feet;
+  feet.Nearest.assign(count, -1);
+  feet.SquaredDistance.assign(count, std::numeric_limits<float>::infinity());
+  const double maximumSpacing = std::max({ spacing[0], spacing[1], spacing[2] });
+  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  std::vector<uint8_t> besideSurface(count, 0);
+  for (int k = box[4]; k <= box[5]; ++k)
+  {
+    for (int j = box[2]; j <= box[3]; ++j)
+    {
+      for (int i = box[0]; i <= box[1]; ++i)
+      {
+        const vtkIdType voxel = grid.Index(i, j, k);
+        const double g0 = grid.Values[voxel];
+        const int ijk[3] = { i, j, k };
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          if (ijk[axis] + 1 >= dims[axis])
+          {
+            continue;
+          }
+          const vtkIdType neighbour = voxel + strides[axis];
+          const double g1 = grid.Values[neighbour];
+          if ((g0 <= 0.0) == (g1 <= 0.0))
+          {
+            continue;
+          }
+          const double t = g0 / (g0 - g1);
+          double p[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
+          p[axis] += t * spacing[axis];
+          const int32_t foot = feet.Add(p);
+          double at[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
+          feet.Offer(voxel, foot, at);
+          at[axis] += spacing[axis];
+          feet.Offer(neighbour, foot, at);
+          besideSurface[voxel] = besideSurface[neighbour] = 1;
+        }
+      }
+    }
+  }
+  for (vtkIdType voxel = 0; voxel < count; ++voxel)
+  {
+    if (!besideSurface[voxel])
+    {
+      continue;
+    }
+    const int i = static_cast<int>(voxel % dims[0]);
+    const int j = static_cast<int>((voxel / dims[0]) % dims[1]);
+    const int k = static_cast<int>(voxel / strides[2]);
+    const double start[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
+    double x[3] = { start[0], start[1], start[2] };
+    double value = 0.0;
+    for (int iteration = 0; iteration < 12; ++iteration)
+    {
+      double gradient[3];
+      value = grid.Evaluate(x, gradient);
+      const double squaredNorm = gradient[0] * gradient[0] + gradient[1] * gradient[1] + gradient[2] * gradient[2];
+      if (std::abs(value) < 1e-7 || squaredNorm < 1e-12)
+      {
+        break;
+      }
+      double factor = value / squaredNorm;
+      const double length = std::abs(factor) * std::sqrt(squaredNorm);
+      factor *= length > 0.5 * maximumSpacing ? 0.5 * maximumSpacing / length : 1.0;
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        x[axis] -= factor * gradient[axis];
+      }
+    }
+    const double moved2 = (x[0] - start[0]) * (x[0] - start[0]) + (x[1] - start[1]) * (x[1] - start[1]) + (x[2] - start[2]) * (x[2] - start[2]);
+    if (std::abs(value) < 1e-5 && moved2 < 4.0 * maximumSpacing * maximumSpacing)
+    {
+      feet.Offer(voxel, feet.Add(x), start);
+    }
+  }
+  std::vector<uint8_t>().swap(besideSurface);
+
+  for (int round = 0; round < 2; ++round)
+  {
+    Sweep(grid, feet, true);
+    Sweep(grid, feet, false);
+  }
+
+  auto field = std::unique_ptr<vtkVolumeCutNerveMonitorField>(new vtkVolumeCutNerveMonitorField);
+  std::copy(origin, origin + 3, field->Origin);
+  std::copy(dims, dims + 3, field->Dimensions);
+  std::copy(spacing, spacing + 3, field->Spacing);
+  field->Range = range;
+  field->NumberOfFootPoints = feet.X.size();
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    // The smoothed surface may reach a voxel beyond the structure's voxels.
+    field->LabelLower[axis] = origin[axis] + labelBox[2 * axis] - 1.0;
+    field->LabelUpper[axis] = origin[axis] + labelBox[2 * axis + 1] + 1.0;
+    field->BrickCounts[axis] = std::max(1, (dims[axis] - 1 + BrickCells - 1) / BrickCells);
+  }
+  const vtkIdType brickCount = static_cast<vtkIdType>(field->BrickCounts[0]) * field->BrickCounts[1] * field->BrickCounts[2];
+  field->Directory.assign(brickCount, FarOutside);
+  constexpr int samplesPerBrick = BrickSamples * BrickSamples * BrickSamples;
+  std::vector<float> samples(samplesPerBrick);
+  for (int bz = 0; bz < field->BrickCounts[2]; ++bz)
+  {
+    for (int by = 0; by < field->BrickCounts[1]; ++by)
+    {
+      for (int bx = 0; bx < field->BrickCounts[0]; ++bx)
+      {
+        double nearest = std::numeric_limits<double>::infinity();
+        bool inside = false;
+        int n = 0;
+        for (int z = 0; z < BrickSamples; ++z)
+        {
+          const int k = std::min(bz * BrickCells + z, dims[2] - 1);
+          for (int y = 0; y < BrickSamples; ++y)
+          {
+            const int j = std::min(by * BrickCells + y, dims[1] - 1);
+            for (int x = 0; x < BrickSamples; ++x, ++n)
+            {
+              const int i = std::min(bx * BrickCells + x, dims[0] - 1);
+              const vtkIdType voxel = grid.Index(i, j, k);
+              const double distance = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
+              const bool in = grid.Values[voxel] <= 0.f;
+              samples[n] = static_cast<float>(in ? -distance : distance);
+              nearest = std::min(nearest, distance);
+              inside = inside || in;
+            }
+          }
+        }
+        const vtkIdType brick = bx + static_cast<vtkIdType>(field->BrickCounts[0]) * (by + static_cast<vtkIdType>(field->BrickCounts[1]) * bz);
+        if (nearest <= range)
+        {
+          field->Directory[brick] = static_cast<int32_t>(field->Bricks.size() / samplesPerBrick);
+          field->Bricks.insert(field->Bricks.end(), samples.begin(), samples.end());
+        }
+        else
+        {
+          field->Directory[brick] = inside ? DeepInside : FarOutside;
+        }
+      }
+    }
+  }
+  field->Bricks.shrink_to_fit();
+  return field;
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
+{
+  double local[3];
+  int brick[3];
+  int cell[3];
+  double t[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    local[axis] = ijk[axis] - this->Origin[axis];
+    if (!(local[axis] >= 0.0 && local[axis] <= this->Dimensions[axis] - 1)) // NaN too
+    {
+      return this->GetFarDistance(ijk);
+    }
+    brick[axis] = std::min(static_cast<int>(local[axis]) / BrickCells, this->BrickCounts[axis] - 1);
+    const double inBrick = local[axis] - brick[axis] * BrickCells;
+    cell[axis] = std::min(static_cast<int>(inBrick), BrickCells - 1);
+    t[axis] = inBrick - cell[axis];
+  }
+  const int32_t index = this->Directory[brick[0] + static_cast<size_t>(this->BrickCounts[0]) * (brick[1] + static_cast<size_t>(this->BrickCounts[1]) * brick[2])];
+  if (index < 0)
+  {
+    return index == DeepInside ? -this->Range : this->GetFarDistance(ijk);
+  }
+  const float* s = this->Bricks.data() + static_cast<size_t>(index) * BrickSamples * BrickSamples * BrickSamples +
+    cell[0] + BrickSamples * (cell[1] + BrickSamples * cell[2]);
+  constexpr int sy = BrickSamples;
+  constexpr int sz = BrickSamples * BrickSamples;
+  const double x00 = s[0] + t[0] * (s[1] - s[0]);
+  const double x10 = s[sy] + t[0] * (s[sy + 1] - s[sy]);
+  const double x01 = s[sz] + t[0] * (s[sz + 1] - s[sz]);
+  const double x11 = s[sz + sy] + t[0] * (s[sz + sy + 1] - s[sz + sy]);
+  const double y0 = x00 + t[1] * (x10 - x00);
+  const double y1 = x01 + t[1] * (x11 - x01);
+  return y0 + t[2] * (y1 - y0);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutNerveMonitorField::GetFarDistance(const double ijk[3]) const
+{
+  double squared = 0.0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double gap = std::max({ this->LabelLower[axis] - ijk[axis], ijk[axis] - this->LabelUpper[axis], 0.0 }) * this->Spacing[axis];
+    squared += gap * gap;
+  }
+  const double distance = std::sqrt(squared);
+  return distance > this->Range ? distance : this->Range; // NaN positions give Range
+}
+
+//------------------------------------------------------------------------------
+size_t vtkVolumeCutNerveMonitorField::GetMemorySize() const
+{
+  return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float);
+}
