@@ -8,6 +8,7 @@
 #include "vtkVolumeCutEmptySpace.h"
 #include "vtkVolumeCutField.h"
 #include "vtkVolumeCutLabelSmoothing.h"
+#include "vtkVolumeCutPartialVolumeLabels.h"
 #include "vtkVolumeCutLocalizedUpdate.h"
 #include "vtkVolumeCutParallelFor.h"
 #include "vtkVolumeCutRayMarcher.h"
@@ -69,6 +70,12 @@ struct vtkVolumeCutRayCaster::Internals
   vtkMTimeType AnatomyCopyTime = 0;
   vtkSmartPointer<vtkImageData> LabelMap;
   vtkMTimeType LabelCopyTime = 0;
+  /// The label map as given; Scene.Labels is it resolved against the CT
+  /// and the styles (vtkVolumeCutPartialVolumeLabels), made again when the
+  /// labels, the CT or what the styles show change.
+  std::vector<uint16_t> GivenLabels;
+  std::vector<float> ResolvedStyles; // per label: shown, shape, iso
+  bool LabelsResolved = false;
   bool DefaultStyles = true;
   struct FractionInput
   {
@@ -430,9 +437,10 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   vtkImageData* labelMap = impl.LabelMap;
   if (!labelMap)
   {
-    if (!impl.Scene.Labels.empty())
+    if (!impl.Scene.Labels.empty() || !impl.GivenLabels.empty())
     {
       impl.Scene.Labels.clear();
+      impl.GivenLabels.clear();
       ++impl.LabelVersion;
       sceneChanged = true;
       impl.BlockTime = 0;
@@ -445,18 +453,19 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     if (!labelScalars || !vtkVolumeCutSceneInputs::SameDimensions(labelMap, anatomy))
     {
       vtkErrorMacro("Render: the label map must have the anatomy's dimensions; rendering without labels");
-      impl.Scene.Labels.clear();
+      impl.GivenLabels.clear();
     }
-    else if (vtkVolumeCutSceneInputs::CopyLabels(labelScalars, impl.Scene.Labels))
+    else if (vtkVolumeCutSceneInputs::CopyLabels(labelScalars, impl.GivenLabels))
     {
       vtkWarningMacro("Render: label values outside 0..65535 were clamped");
     }
     impl.LabelCopyTime = std::max(labelMap->GetMTime(), labelScalars ? labelScalars->GetMTime() : 0);
-    ++impl.LabelVersion;
-    impl.BlockTime = 0;
-    sceneChanged = true;
+    impl.LabelsResolved = false;
   }
-
+  else if (sceneChanged)
+  {
+    impl.LabelsResolved = false; // the CT changed under the same labels
+  }
   // Fractional labelmaps, copied to floats 0..1 when any of them changed.
   vtkMTimeType fractionTime = 0;
   for (const auto& entry : impl.FractionInputs)
@@ -505,6 +514,33 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   if (impl.Scene.Styles.size() < 2)
   {
     impl.Scene.Styles.resize(2);
+  }
+
+  // Partial-volume voxels go to the shown segment whose material fills
+  // them: which ones depends on what the styles show.
+  std::vector<float> resolvedStyles;
+  for (const SegmentStyle& style : impl.Scene.Styles)
+  {
+    const bool shown = style.Opacity > 0.f;
+    resolvedStyles.insert(resolvedStyles.end(), { shown ? 1.f : 0.f, style.Shape ? 1.f : 0.f, shown && !style.Shape ? style.Iso : 0.f });
+  }
+  if (!impl.LabelsResolved || resolvedStyles != impl.ResolvedStyles)
+  {
+    std::vector<uint16_t> resolved;
+    if (!impl.GivenLabels.empty())
+    {
+      vtkVolumeCutPartialVolumeLabels::Resolve(
+        impl.GivenLabels, impl.Scene.Values, impl.Scene.Dimensions, impl.Scene.Styles, this->MaximumNumberOfThreads, resolved);
+    }
+    impl.LabelsResolved = true;
+    impl.ResolvedStyles = resolvedStyles;
+    if (resolved != impl.Scene.Labels)
+    {
+      impl.Scene.Labels.swap(resolved);
+      ++impl.LabelVersion;
+      impl.BlockTime = 0;
+      sceneChanged = true;
+    }
   }
 
   // Segments drawn by their shape from the label map alone: fractions from

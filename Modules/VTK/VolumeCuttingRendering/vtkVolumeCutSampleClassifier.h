@@ -306,6 +306,10 @@ public:
   /// label's interpolated indicator). Where two segments meet, their border is
   /// where their weights are equal, a smooth surface; where a segment meets
   /// the background, the CT's iso-surface (or the indicator at 0.5) decides.
+  /// The label map read here is resolved first (vtkVolumeCutPartialVolumeLabels):
+  /// hidden voxels below every iso-value are background, and partial-volume
+  /// voxels beside a shown iso segment are that segment's, so neither cuts
+  /// its iso-surface flat at the labels' border.
   int DominantLabel(const double p[3], double& weight) const
   {
     const vtkVolumeCutRayScene& scene = this->Scene;
