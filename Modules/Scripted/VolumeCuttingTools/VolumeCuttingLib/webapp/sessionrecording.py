@@ -53,7 +53,7 @@ KEY_METRICS = (
     ("safety.min_distance_mm", "closest approach to a structure at risk", "mm"),
     ("safety.large_burr_within_2mm_s", "large cutting burr within 2 mm", "s"),
     ("final.dice", "overlap with the reference (Dice)", ""),
-    ("efficiency.removed_mm3", "removed", "mm³"),
+    ("final.removed_mm3", "removed at the end (voxels of the scan)", "mm³"),
     ("efficiency.strokes", "strokes", ""),
     ("efficiency.undo", "undo", ""),
     ("efficiency.duration_s", "time", "s"),
@@ -250,10 +250,12 @@ def reference_for(scan: scans.Scan) -> dict | None:
     return sessions.careful(scan)
 
 
-def grade(recording: dict) -> metriclib.Assessment:
-    """The assessment of a web recording (against the careful session where there is one)."""
+def grade(recording: dict, path=None) -> metriclib.Assessment:
+    """The assessment of a web recording (``path``: where its file is), against the careful session where there is one."""
     scan = scans.from_descriptor(recording.get("scan"))
-    return metriclib.assess(recording, scan, reference_for(scan))
+    reference = reference_for(scan)
+    return metriclib.assess(recording, scan, reference, recording_path=path,
+                            reference_path=f"the careful mastoidectomy on the {scan.name} (assessment.sessions)" if reference else None)
 
 
 def _shown(value) -> str:
@@ -269,6 +271,7 @@ class ReportPanel:
 
     def __init__(self, server, recording: WebSessionRecording, records_url: str | None = None, progress=None):
         self.server = server
+        self.work_directory = recording.session.work_directory
         self.recording = recording
         self.records_url = records_url
         self.progress = progress
@@ -300,7 +303,10 @@ class ReportPanel:
             if "scan" not in snapshot:
                 raise sessionlib.SessionError("This scan is not one the assessment can rebuild (the phantom or the example "
                                               "head CT): the recording can be downloaded, not graded here")
-            assessment = grade(snapshot)
+            # The server keeps what it graded: the records name the file, and it outlives the page.
+            stamp = snapshot["started"].replace(":", "").replace("+0000", "Z")
+            path = recordings.save(snapshot, self.work_directory / "recordings" / f"session-{stamp}-{len(snapshot['strokes'])}.json")
+            assessment = grade(snapshot, path)
             self._show(assessment)
             self.assessment, self.graded = assessment, snapshot
         except (sessionlib.SessionError, recordings.RecordingError, scans.ScanError, metriclib.AssessmentError) as error:
