@@ -30,7 +30,6 @@ import asyncio
 import json
 from dataclasses import asdict
 
-import numpy as np
 import vtk
 from trame.widgets import html
 from trame.widgets import vuetify3 as v3
@@ -40,6 +39,7 @@ from ..assessment import report as reportlib
 from ..assessment import scans, sessions
 from ..config import toolconfig
 from ..cutting import recording as recordings
+from ..data import owndata
 from ..records import pending
 from ..records.assessment import AssessmentError as RecordsAssessmentError
 from . import session as sessionlib
@@ -238,8 +238,6 @@ def replay_in(session, recording: dict) -> dict:
         return recordings.replay(session.logic, session.cut_node, recording, tool_nodes)
     finally:
         session.cut_node.SetAndObserveActiveToolNodeID(session.tool_node.GetID())
-        from ..data import owndata
-
         owndata.remove_nodes(session.scene, *reversed([n for n in created if n is not None]))
 
 
