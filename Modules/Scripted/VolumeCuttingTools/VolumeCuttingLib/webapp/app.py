@@ -45,7 +45,7 @@ from wslink.websocket import LinkProtocol
 from ..config import toolconfig
 from ..data import headct, owndata
 from ..jobs import softcutjob
-from . import progress, rendering, views
+from . import progress, rendering, sessionrecording, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)
 
@@ -214,8 +214,11 @@ class VolumeCuttingApp(TrameApp):
         self._register_views()
         self._initialize_state()
         self.progress = progress.ProgressPanel(self.server, self.options.records)
+        self.recording = sessionrecording.WebSessionRecording(self.session)
+        self.report = sessionrecording.ReportPanel(self.server, self.recording, self.options.records, self.progress)
         self._build_ui()
         self._connect_three_d_view()
+        self.recording.watch(self._three_d_factory.areas[THREE_D_TAG])
 
     # ------------------------------------------------------------------ views
 
@@ -381,6 +384,7 @@ class VolumeCuttingApp(TrameApp):
         undo, redo = self.session.undo_redo_counts()
         self.state.vc_undo_count, self.state.vc_redo_count = undo, redo
         self.state.vc_contacts = self._contact_rows()
+        self.report.refresh_counts()
         self._last_table_refresh = time.monotonic()
 
     def _contact_rows(self) -> list[dict]:
@@ -880,6 +884,7 @@ class VolumeCuttingApp(TrameApp):
             self._softcut_panel()
             self._export_panel()
             self.progress.build()
+            self.report.build()
 
     def _data_panel(self) -> None:
         with v3.VExpansionPanel(value="data", title="Data"), v3.VExpansionPanelText():

@@ -163,6 +163,7 @@ class DrillSession:
         self.warnings: list[str] = []
         self._data_nodes: list = []
         self.action = None  # slicer.vtkSlicerVolumeCuttingLogic.ToolCut or ToolRestore inside a stroke
+        self.stroke_listener = None  # told of strokes, their poses, undo and redo (sessionrecording records them)
         self._presets = {preset.name: preset for preset in toolconfig.load_presets()}
 
     # ------------------------------------------------------------------ data
@@ -390,12 +391,16 @@ class DrillSession:
         if not self.logic.BeginStroke(self.cut_node):
             return False
         self.action = slicer.vtkSlicerVolumeCuttingLogic.ToolRestore if restore else slicer.vtkSlicerVolumeCuttingLogic.ToolCut
+        if self.stroke_listener is not None:
+            self.stroke_listener.stroke_began(restore)
         return True
 
     def move_tool(self, pose: vtk.vtkMatrix4x4) -> bool:
         """Move the tool to ``pose``; inside a stroke it cuts (or restores) along the way."""
         self._require_data()
         action = self.action if self.action is not None else slicer.vtkSlicerVolumeCuttingLogic.ToolMove
+        if self.action is not None and self.stroke_listener is not None:
+            self.stroke_listener.tool_moved(pose)
         return bool(self.logic.MoveActiveTool(self.cut_node, pose, action))
 
     def end_stroke(self) -> bool:
@@ -404,7 +409,10 @@ class DrillSession:
             self.action = None
             return False
         self.action = None
-        return bool(self.logic.EndStroke(self.cut_node))
+        ended = bool(self.logic.EndStroke(self.cut_node))
+        if self.stroke_listener is not None:
+            self.stroke_listener.stroke_ended()
+        return ended
 
     @property
     def in_stroke(self) -> bool:
@@ -413,12 +421,17 @@ class DrillSession:
     def undo(self) -> bool:
         self._require_data()
         self.end_stroke()
-        return bool(self.logic.UndoStroke(self.cut_node))
+        return self._edited("undo", self.logic.UndoStroke(self.cut_node))
 
     def redo(self) -> bool:
         self._require_data()
         self.end_stroke()
-        return bool(self.logic.RedoStroke(self.cut_node))
+        return self._edited("redo", self.logic.RedoStroke(self.cut_node))
+
+    def _edited(self, kind: str, done) -> bool:
+        if done and self.stroke_listener is not None:
+            self.stroke_listener.edited(kind)
+        return bool(done)
 
     def undo_redo_counts(self) -> tuple[int, int]:
         field = self.cut_node.GetCutField() if self.has_data else None
