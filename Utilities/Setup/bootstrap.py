@@ -46,6 +46,8 @@ APT_PACKAGES = [
     "libegl1", "libegl-mesa0", "libgl1-mesa-dri",
     # The browser that Playwright drives in the web application's tests (no browser download).
     "chromium",
+    # PortAudio, which sounddevice loads for the desktop drill sound (without it the session runs silent).
+    "libportaudio2",
 ]
 
 

@@ -220,6 +220,7 @@ class DrillSoundRenderer:
         self._gains = {"idle": 0.0, "cutting": 0.0, "diamond": 0.0, "click": 0.0, "volume": self.parameters.volume}
         self._phase = 0.0  # cycles of the fundamental, kept in [0, 1)
         self._click_phase = 0.0  # cycles of the click (or burst) clock
+        self._clicks_active = False
         self._click_tail = np.zeros(0)  # click samples still to play
         self._harmonics = np.array(HARMONICS, dtype=float)
         # Per spectrum: partial amplitudes over HARMONICS, normalised to the tone budget.
@@ -334,7 +335,12 @@ class DrillSoundRenderer:
         train = np.zeros(max(frames, len(self._click_tail)))
         train[:len(self._click_tail)] = self._click_tail
         p = self.parameters
-        if p.monitor_level != "silent" and p.monitor_rate_hz > 0.0:
+        active = p.monitor_level != "silent" and p.monitor_rate_hz > 0.0
+        if active and not self._clicks_active:
+            # The monitor fires at once when it starts firing, not one period later.
+            self._click_phase = math.nextafter(1.0, 0.0)
+        self._clicks_active = active
+        if active:
             bursts = p.monitor_level == "bursts"
             step = p.monitor_rate_hz / (CLICKS_PER_BURST if bursts else 1) / self.config.sample_rate
             clock = self._click_phase + step * np.arange(1, frames + 1)
