@@ -344,8 +344,10 @@ class VolumeCuttingApp(TrameApp):
             "vc_sc_depth": self.softcut.depth_mm, "vc_sc_previewing": False, "vc_sc_skin": False,
             "vc_sc_error": "", "vc_sc_status": "", "vc_sc_measurements": [],
             "vc_sc_export_name": "resection.stl",
-            # The drill sound: parameters from the server; the switch and volume are each page's own.
-            "vc_sound": self.sound.initial_state(), "vc_sound_on": False, "vc_sound_volume": 0.5, "vc_sound_message": "",
+            # The drill sound: parameters from the server (www/drillsound.js watches them outside the template,
+            # which would otherwise render again at every update); the switch and volume are each page's own.
+            "vc_sound": self.sound.initial_state(), "vc_sound_config": self.sound.config_state(),
+            "vc_sound_on": False, "vc_sound_volume": 0.5, "vc_sound_message": "",
         })
         state.client_only("vc_client_id", "vc_sound_on", "vc_sound_volume", "vc_sound_message")
         self._update_mode_hint()
@@ -841,7 +843,6 @@ class VolumeCuttingApp(TrameApp):
             self.ui = layout
             layout.title.set_text("VolumeCutting")
             client.ClientTriggers(mounted="trigger('vc_hello').then((id) => { vc_client_id = id })")
-            client.ClientStateChange(value="vc_sound", immediate=True, change="utils.vc.sound && utils.vc.sound.update(vc_sound)")
             with layout.toolbar:
                 v3.VSpacer()
                 with v3.VBtnToggle(v_model=("vc_mode",), mandatory=True, density="compact", classes="mr-2",

@@ -100,7 +100,7 @@ class ProtectedDistance:
 
 
 class SoundFeed:
-    """Keeps ``vc_sound`` in the state while drilling: {parameters, config, sent_at (ms since the epoch)}."""
+    """Keeps ``vc_sound`` in the state while drilling: {parameters, sent_at (ms since the epoch)}."""
 
     def __init__(self, session, state, config: drillsound.SoundConfig | None = None):
         self.session = session
@@ -117,8 +117,11 @@ class SoundFeed:
         return self._message(drillsound.SoundParameters())
 
     def _message(self, parameters: drillsound.SoundParameters) -> dict:
-        return {"parameters": parameters.as_dict(), "config": dataclasses.asdict(self.config),
-                "sent_at": time.time() * 1000.0}
+        return {"parameters": parameters.as_dict(), "sent_at": time.time() * 1000.0}
+
+    def config_state(self) -> dict:
+        """The sound's configuration for the page (``vc_sound_config``), sent once: not in every update."""
+        return dataclasses.asdict(self.config)
 
     def bone_ahead_mm(self) -> float:
         """The stand-in for the bone left ahead: burr surface to the nearest protected voxel (mm)."""

@@ -60,8 +60,9 @@
       return { ...values, volume: this.volume };
     },
 
-    // The server's parameters (trame state vc_sound): {parameters, config, sent_at (ms since the epoch)}.
-    update(state) {
+    // The server's parameters (trame state vc_sound): {parameters, sent_at (ms since the epoch)}, and its
+    // configuration (vc_sound_config), which the worklet takes when it starts.
+    update(state, config) {
       if (!state || !state.parameters) return;
       this.received += 1;
       const now = Date.now();
@@ -69,7 +70,7 @@
       if (state.sent_at) this.transportMs.push(now - state.sent_at);
       if (this.receivedAt.length > 2000) this.receivedAt.shift();
       if (this.transportMs.length > 2000) this.transportMs.shift();
-      if (state.config) this.config = state.config;
+      if (config) this.config = config;
       this.parameters = state.parameters;
       this.post(this.parameters);
     },
@@ -146,10 +147,13 @@
 
   window.vcDrillSound = sound;
   (function register(attempts) {
-    if (!window.trame || !window.trame.utils || !window.trame.utils.vc) {
+    const trame = window.trame;
+    if (!trame || !trame.utils || !trame.utils.vc || !trame.state || !trame.state.watch) {
       if (attempts > 0) setTimeout(() => register(attempts - 1), 10);  // a page without trame: stop after 30 s
       return;
     }
-    window.trame.utils.vc.sound = sound;
+    trame.utils.vc.sound = sound;
+    // Watched here, not in the page's template: a template that reads vc_sound renders again at each update.
+    trame.state.watch(["vc_sound", "vc_sound_config"], (state, config) => sound.update(state, config));
   })(3000);
 })();
