@@ -28,7 +28,7 @@ from vtkmodules.util import numpy_support
 
 from ..feedback import drillsound
 
-PERIOD_S = 1.0 / 60.0  # 60 Hz: above the 50 Hz asked for, with room for a late tick
+PERIOD_S = 1.0 / 75.0  # 75 Hz: above the 50 Hz asked for, with room for ticks a busy event loop delays
 
 
 class ProtectedDistance:
