@@ -49,6 +49,8 @@ APT_PACKAGES = [
     "chromium",
     # The PostgreSQL server (15) that the trainee-records tests start on a temporary cluster.
     "postgresql",
+    # PortAudio, which sounddevice loads for the desktop drill sound (without it the session runs silent).
+    "libportaudio2",
 ]
 
 

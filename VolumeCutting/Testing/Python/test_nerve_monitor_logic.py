@@ -14,7 +14,7 @@ import slicer
 import vtk
 
 from test_haptic_session import add_burr, block_scene
-from VolumeCuttingLib.feedback import nervemonitor
+from VolumeCuttingLib.feedback import drillsound, nervemonitor
 
 NERVE_END_X = 3.25
 BURR_RADIUS = 2.0
@@ -38,15 +38,22 @@ def test_the_logic_monitors_the_protected_nerve_as_the_tool_moves():
                       lambda caller, event: changes.__setitem__("n", changes["n"] + 1))
     levels = []
     distances = []
+    sounds = []
     for x in np.arange(-6.0, 1.6, 0.25):
         assert logic.MoveActiveTool(cut, pose(x), slicer.vtkSlicerVolumeCuttingLogic.ToolMove)
         reading = nervemonitor.readings(monitor)["Nerve"]
+        # What the drill sound mixes in: a level it knows, the rate the monitor fires at.
+        sound_level, sound_rate = nervemonitor.sound_input(monitor)
+        assert sound_level in drillsound.MONITOR_LEVELS and sound_rate == reading["firing_rate_hz"]
+        sounds.append(sound_level)
         expected = NERVE_END_X - x - BURR_RADIUS
         assert abs(reading["distance_mm"] - expected) < 0.1, (x, reading)
         distances.append(reading["distance_mm"])
         levels.append(reading["level"])
     assert np.all(np.diff(distances) < 0)
     assert levels[0] == "silent" and levels[-1] == "contact"
+    assert [level for n, level in enumerate(sounds) if n == 0 or level != sounds[n - 1]] == list(drillsound.MONITOR_LEVELS)
+    assert nervemonitor.sound_input(None) == ("silent", 0.0)
     assert [level for n, level in enumerate(levels) if n == 0 or level != levels[n - 1]] == list(nervemonitor.LEVEL_NAMES)
     # One event per change of level (the first reading, from "not ready", included).
     assert changes["n"] == len(nervemonitor.LEVEL_NAMES)

@@ -21,6 +21,7 @@ from .harness import write_results
 AREAS = {
     "foundation": ("foundation", "foundation"),
     "cutfield": ("cutfield", "cutfield"),
+    "feedback": ("feedback", "feedback"),
     "mapper": ("mapper", "mapper"),
     "gpuprogram": ("gpuprogram", "gpuprogram"),
     "workflow": ("workflow", "workflow"),

@@ -79,6 +79,20 @@ def loudest(current: dict) -> tuple[str, dict] | None:
     return max(ready, key=lambda item: (LEVEL_NAMES.index(item[1]["level"]), -item[1]["distance_mm"]))
 
 
+# The drill sound's names for the monitor's levels (``drillsound.MONITOR_LEVELS``).
+SOUND_LEVELS = {"silent": "silent", "sparse clicks": "sparse", "bursts": "bursts", "continuous": "continuous",
+                "contact": "contact"}
+
+
+def sound_input(monitor) -> tuple[str, float]:
+    """What the drill sound mixes in: the loudest structure's level and firing rate (silent until one is ready)."""
+    top = loudest(readings(monitor)) if monitor is not None else None
+    if top is None:
+        return "silent", 0.0
+    reading = top[1]
+    return SOUND_LEVELS[reading["level"]], float(reading["firing_rate_hz"])
+
+
 def monitor_for(logic, cut_node, segment_ids=None, wait: bool = True):
     """The cut node's monitor from the module logic, watching ``segment_ids`` (None: the protected segments).
 

@@ -44,13 +44,15 @@ from wslink.websocket import LinkProtocol
 
 from ..config import toolconfig
 from ..data import headct, owndata
+from ..feedback import nervemonitor
 from ..jobs import softcutjob
-from . import progress, rendering, sessionrecording, views
+from . import progress, rendering, sessionrecording, soundfeed, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)
 
 WWW = Path(__file__).with_name("www")
-CLIENT_MODULE = {"serve": {"__volumecutting": str(WWW)}, "scripts": ["__volumecutting/volumecutting.js"]}
+CLIENT_MODULE = {"serve": {"__volumecutting": str(WWW)},
+                 "scripts": ["__volumecutting/volumecutting.js", "__volumecutting/drillsound.js"]}
 
 LAYOUT_ID = "volumecutting"
 # VOLUMECUTTING_WEBAPP_TRACE=1 prints each frame of the 3D view (window, size, time).
@@ -197,6 +199,8 @@ class VolumeCuttingApp(TrameApp):
         self.drill.on_hover = lambda: self.progressive.pointer_moved()
         self.drill.on_depth_changed = self._on_depth_changed
         self.softcut = SoftCutSession(self.session)
+        self.sound = soundfeed.SoundFeed(self.session, self.state)
+        self.sound.monitor = self._monitor_for_sound
         self.drill.on_outline_pick = self._on_outline_pick
         self._outline_model = None
         self._pipeline_creator = slicer.vtkMRMLLayerDMPipelineScriptedCreator()
@@ -219,6 +223,12 @@ class VolumeCuttingApp(TrameApp):
         self._build_ui()
         self._connect_three_d_view()
         self.recording.watch(self._three_d_factory.areas[THREE_D_TAG])
+
+    def _monitor_for_sound(self) -> tuple[str, float]:
+        """The nerve monitor's clicks in the drill sound: its loudest structure (the logic updates it at every pose)."""
+        if not self.session.has_data:
+            return "silent", 0.0
+        return nervemonitor.sound_input(self.session.logic.GetNerveMonitor(self.session.cut_node))
 
     # ------------------------------------------------------------------ views
 
@@ -350,8 +360,12 @@ class VolumeCuttingApp(TrameApp):
             "vc_sc_depth": self.softcut.depth_mm, "vc_sc_previewing": False, "vc_sc_skin": False,
             "vc_sc_error": "", "vc_sc_status": "", "vc_sc_measurements": [],
             "vc_sc_export_name": "resection.stl",
+            # The drill sound: parameters from the server (www/drillsound.js watches them outside the template,
+            # which would otherwise render again at every update); the switch and volume are each page's own.
+            "vc_sound": self.sound.initial_state(), "vc_sound_config": self.sound.config_state(),
+            "vc_sound_on": False, "vc_sound_volume": 0.5, "vc_sound_message": "",
         })
-        state.client_only("vc_client_id")
+        state.client_only("vc_client_id", "vc_sound_on", "vc_sound_volume", "vc_sound_message")
         self._update_mode_hint()
 
     @staticmethod
@@ -381,6 +395,7 @@ class VolumeCuttingApp(TrameApp):
             for r in rows
         ]
         self.state.vc_total_removed = round(sum(r.removed_mm3 for r in rows), 2)
+        self.sound.note_removed(sum(r.removed_mm3 for r in rows))
         undo, redo = self.session.undo_redo_counts()
         self.state.vc_undo_count, self.state.vc_redo_count = undo, redo
         self.state.vc_contacts = self._contact_rows()
@@ -440,6 +455,7 @@ class VolumeCuttingApp(TrameApp):
             view.set_render_blocked(True)
         self.state.vc_contact, self.state.vc_contact_fix = "", None
         self.drill.set_glyph(in_contact=False)
+        self.sound.stroke_began(self.state.vc_total_removed)
 
     def _on_stroke_moved(self) -> None:
         # The removed volume follows live, a few times a second.
@@ -448,6 +464,7 @@ class VolumeCuttingApp(TrameApp):
             self._refresh_tables()
 
     def _on_stroke_end(self) -> None:
+        self.sound.stroke_ended()
         self.progressive.stroke_ended()
         self._refresh_tables()
         self._jump_slices_to_tool()
@@ -975,12 +992,27 @@ class VolumeCuttingApp(TrameApp):
             html.Div("Press and drag on the bone in Drill mode. The wheel changes the depth; "
                      "hold Shift to drill twice as deep. Restore mode adds bone back.", classes="text-caption")
             html.Div("Undo steps: {{ vc_undo_count }}, redo steps: {{ vc_redo_count }}", classes="text-caption mt-1")
+            self._sound_controls()
             with html.Div(v_if="vc_contacts.length", classes="mt-2", raw_attrs=['data-testid="contacts"']):
                 # The logic's contact table is a record of the session: undo takes the cut back, not the contact.
                 html.Div("Touched so far (structures the tool may not cut; undo keeps this record):",
                          classes="text-body-2 text-error")
                 with html.Div(v_for="(c, i) in vc_contacts", key="i", classes="text-caption"):
                     html.Span("{{ c.name }}: {{ c.depth.toFixed(2) }} mm")
+
+    def _sound_controls(self) -> None:
+        """The drill sound's switch and volume: the page plays it (Web Audio), each page at its own volume."""
+        with html.Div(classes="d-flex align-center mt-1"):
+            v3.VSwitch(v_model=("vc_sound_on",), label="Drill sound", density="compact", hide_details=True,
+                       color="primary", raw_attrs=['data-testid="sound-switch"'],
+                       update_modelValue=("$event ? utils.vc.sound.start(vc_sound_volume).then((ok) => "
+                                          "{ vc_sound_message = utils.vc.sound.message; if (!ok) vc_sound_on = false; }) "
+                                          ": utils.vc.sound.stop()"))
+            v3.VSlider(v_model=("vc_sound_volume",), min=0, max=1, step=0.05, density="compact", hide_details=True,
+                       prepend_icon="mdi-volume-high", classes="ml-3", disabled=("!vc_sound_on",),
+                       raw_attrs=['data-testid="sound-volume"'], update_modelValue="utils.vc.sound.setVolume($event)")
+        html.Div("{{ vc_sound_message }}", v_if="vc_sound_message", classes="text-caption text-warning",
+                 raw_attrs=['data-testid="sound-message"'])
 
     def _softcut_panel(self) -> None:
         with v3.VExpansionPanel(value="softcut", title="SoftCut (soft-tissue resection)",

@@ -9,7 +9,9 @@ Shared by the browser tests and the ``webapp`` benchmark area:
 * ``AppPage``: the page: wait until the CT is shown, switch modes, drag in
   the 3D view, read the segments table and the 3D view's pixels, download
   exports; and, for timing, the time each frame of the 3D view reached the
-  page (``TIMING_HOOK``).
+  page (``TIMING_HOOK``);
+* ``SoundPage``: the page's drill sound (AudioWorklet) alone, rendered
+  offline or timed live.
 
 Every wait has a time limit and says what it waited for when it runs out.
 """
@@ -362,3 +364,78 @@ class AppPage:
             self.page.wait_for_timeout(500)
             box = self.three_d_box()
         return box
+
+
+class SoundPage:
+    """The page's drill sound alone: the application's ``www`` folder served over HTTP on 127.0.0.1 (the
+    same files the application serves) and a page with nothing but ``drillsound.js`` in ``browser``.
+
+    ``render`` renders the AudioWorklet in an OfflineAudioContext; ``measure_latency`` times parameter
+    changes to the changed sound in a live AudioContext, started by a click (the user's gesture).
+    """
+
+    PAGE = b'<html><body><button id="start">start</button><script src="drillsound.js"></script></body></html>'
+
+    def __init__(self, browser):
+        self.browser = browser
+        self.server = None
+        self.context = None
+        self.page = None
+
+    def __enter__(self) -> SoundPage:
+        import functools
+        import http.server
+        import threading
+
+        page_html = self.PAGE
+
+        class Handler(http.server.SimpleHTTPRequestHandler):
+            def do_GET(self):
+                if self.path.startswith("/sound-test.html"):
+                    self.send_response(200)
+                    self.send_header("Content-Type", "text/html")
+                    self.send_header("Content-Length", str(len(page_html)))
+                    self.end_headers()
+                    self.wfile.write(page_html)
+                else:
+                    super().do_GET()
+
+            def log_message(self, *args):
+                pass
+
+        www = Path(__file__).with_name("www")
+        self.server = http.server.ThreadingHTTPServer(("127.0.0.1", free_port()), functools.partial(Handler, directory=str(www)))
+        threading.Thread(target=self.server.serve_forever, daemon=True).start()
+        self.context = self.browser.new_context()
+        self.page = self.context.new_page()
+        self.page.goto(f"http://127.0.0.1:{self.server.server_address[1]}/sound-test.html")
+        self.page.wait_for_function("() => !!window.vcDrillSound", timeout=30000)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.context is not None:
+            self.context.close()
+        if self.server is not None:
+            self.server.shutdown()
+            self.server.server_close()
+
+    def render(self, schedule, seconds: float, config: dict | None = None) -> np.ndarray:
+        """Samples of the worklet for ``schedule`` ([(time_s, parameters dict)]) from a steady start."""
+        samples = self.page.evaluate("([s, n, c]) => window.vcDrillSound.renderOffline(s, n, c)",
+                                     [[[t, p] for t, p in schedule], seconds, config])
+        return np.array(samples)
+
+    def start(self, volume: float = 1.0) -> bool:
+        self.page.evaluate("""(volume) => { document.getElementById('start').onclick = () => {
+            window.soundStarted = window.vcDrillSound.start(volume); }; }""", volume)
+        self.page.click("#start")
+        return bool(self.page.evaluate("() => window.soundStarted"))
+
+    def measure_latency(self, before: dict, after: dict, trials: int = 20) -> list[dict]:
+        """Per change: latencyMs (page change to the changed sound at the output), outputLatencyMs, viaTimestamp."""
+        if not self.start():
+            raise BrowserTestError(f"The page's sound did not start: {self.page.evaluate('() => window.vcDrillSound.message')}")
+        try:
+            return self.page.evaluate("([a, b, n]) => window.vcDrillSound.measureLatency(a, b, n)", [before, after, trials])
+        finally:
+            self.page.evaluate("() => window.vcDrillSound.stop()")
