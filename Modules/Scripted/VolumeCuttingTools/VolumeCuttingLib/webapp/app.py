@@ -213,6 +213,8 @@ class VolumeCuttingApp(TrameApp):
         self.progressive = None
         # For tests and benchmarks (vc_diagnostics): events as applied, when each 3D frame began, each 3D frame
         # (window, start ms, duration ms, width, height, pixels per ray each way) and when the data was ready.
+        # The Ready message of data whose first picture has not reached the page yet (its 3D view had no size).
+        self._ready_when_shown = None
         self.timing = {"events": deque(maxlen=20000), "renders": deque(maxlen=20000), "frames": deque(maxlen=20000),
                        "ready_at": None}
         self.server.add_protocol_to_configure(lambda protocol: protocol.registerLinkProtocol(ConnectionWatch(self)))
@@ -297,6 +299,7 @@ class VolumeCuttingApp(TrameApp):
                                           event.get("x"), event.get("y")))
 
         adapter.on_interaction = on_interaction
+        self._three_d_factory.schedulers[THREE_D_TAG].on_frame_sent = self._three_d_frame_sent
         interactor = area.main_view.interactor()
         for event in ("LeftButtonPressEvent", "MiddleButtonPressEvent", "RightButtonPressEvent"):
             interactor.AddObserver(event, lambda *_: self.progressive.button_pressed(), 10.0)
@@ -308,6 +311,15 @@ class VolumeCuttingApp(TrameApp):
             window.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: self._render_started())
             window.AddObserver(vtk.vtkCommand.EndEvent, lambda w, _e, name=name, view=view: self._render_ended(name, view))
         self.state.vc_three_d_area = get_view_trame_id(self.server, area.main_view)
+
+    def _three_d_frame_sent(self) -> None:
+        """The page says Ready only once the data's first picture is on its way: never over a black view."""
+        if self._ready_when_shown is None or not self.session.has_data or not self._three_d_factory.areas[THREE_D_TAG].sized:
+            return
+        text, self._ready_when_shown = self._ready_when_shown, None
+        self.timing["ready_at"] = time.time() * 1000.0
+        with self.state:
+            self.state.vc_status = text
 
     def _render_started(self) -> None:
         self._render_start = time.time() * 1000.0
@@ -763,6 +775,7 @@ class VolumeCuttingApp(TrameApp):
             return
         with state:
             state.vc_busy, state.vc_error, state.vc_progress, state.vc_status = True, "", 0, "Starting"
+        self._ready_when_shown = None
         self.drill.end_stroke()
         try:
             for fraction, text in self.session.loading(source, **options):
@@ -774,9 +787,12 @@ class VolumeCuttingApp(TrameApp):
             with state:
                 state.vc_progress, state.vc_status = 98, "Drawing the first picture"
             # A quick, coarse first picture now (the full one follows): the page never says Ready over a black view.
-            await self.progressive.first_frame()
-            self.timing["ready_at"] = time.time() * 1000.0
-            state.vc_status = "Ready: " + self.session.description
+            # A page whose 3D view has no size yet (still opening) is told once its first frame is sent.
+            if await self.progressive.first_frame():
+                self.timing["ready_at"] = time.time() * 1000.0
+                state.vc_status = "Ready: " + self.session.description
+            else:
+                self._ready_when_shown = "Ready: " + self.session.description
             state.vc_upload_message = ""  # a refused upload's message no longer applies to the data shown
         except (SessionError, owndata.InputError, headct.HeadCTUnavailableError, OSError) as error:
             state.vc_error = self._with_upload_names(str(error))

@@ -132,6 +132,8 @@ class ProgressiveScheduler(RcaImageRenderScheduler):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._frame_sent = asyncio.Event()
+        # Called after each frame left for the page.
+        self.on_frame_sent = lambda: None
 
     async def send_frame(self, timeout_s: float) -> bool:
         """Draw a frame and wait until it has been sent to the page (False if that took longer than ``timeout_s``)."""
@@ -155,6 +157,7 @@ class ProgressiveScheduler(RcaImageRenderScheduler):
                 self._last_push_time_ms = m_time
                 self._push_callback(image, meta)
             self._frame_sent.set()
+            self.on_frame_sent()
             await asyncio.sleep(max(EVENT_GAP_S, self._target_period_s - (monotonic() - started)))
 
     def _encode_frame(self, quality):
