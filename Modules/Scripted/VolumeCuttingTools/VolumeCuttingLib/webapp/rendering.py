@@ -260,6 +260,8 @@ class ProgressiveRendering:
 
     def stroke_started(self) -> None:
         self._cancel()
+        # A stroke right after a camera move starts from still frames: its frames keep the mapper's own settings.
+        self._set_draft(False)
         self._stroke = True
         self._show(True, self.drill_scale)
 
@@ -360,11 +362,10 @@ class ProgressiveRendering:
 
     def _set_draft(self, draft: bool) -> None:
         """Interactive frames in the preview, or still ones (a stroke's rate is the displayable manager's)."""
-        if draft == self._draft:
+        if draft == self._draft or self._stroke:
+            # During a stroke the flag stays as the mapper is, so that the call after the stroke restores it.
             return
         self._draft = draft
-        if self._stroke:
-            return
         window = self.area.preview_view.render_window()
         coarsest = max(1, round(window.GetSize()[0] / MINIMUM_RAYS_ACROSS))
         for volume in self.area.preview_view.renderer().GetVolumes():
