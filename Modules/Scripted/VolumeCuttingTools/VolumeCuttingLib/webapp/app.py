@@ -86,7 +86,8 @@ class Options:
     segmentation: Path | None = None
     data_dirs: list[Path] = field(default_factory=list)
     max_upload_mb: float = 512.0
-    navigate_scale: float = 0.25
+    navigate_scale: float = 0.5
+    navigate_fps: float = 20.0
     drill_scale: float = 0.5
     refine_delay_s: float = 0.5
     work_dir: Path | None = None
@@ -109,6 +110,9 @@ def add_arguments(parser) -> None:
     group.add_argument("--max-upload-mb", type=float, default=Options.max_upload_mb, help="largest upload accepted (MB)")
     group.add_argument("--navigate-scale", type=float, default=Options.navigate_scale,
                        help="render scale of the 3D view while the camera moves (refined when the mouse stops)")
+    group.add_argument("--navigate-fps", type=float, default=Options.navigate_fps,
+                       help="frames per second the 3D view keeps while the camera moves: the ray caster casts as many "
+                            "rays as fit (full quality when the mouse stops)")
     group.add_argument("--drill-scale", type=float, default=Options.drill_scale, help="render scale of the 3D view while drilling")
     group.add_argument("--work-dir", type=Path, default=None, help="folder for uploads and exports (default: a temporary one)")
     group.add_argument("--records", default=None, metavar="URL",
@@ -123,13 +127,15 @@ def options_from_arguments(args) -> Options:
         value = getattr(args, name)
         if not 0.05 <= value <= 1.0:
             raise SystemExit(f"--{name.replace('_', '-')} {value}: give a fraction between 0.05 and 1")
+    if not 1.0 <= args.navigate_fps <= 120.0:
+        raise SystemExit(f"--navigate-fps {args.navigate_fps}: give a rate between 1 and 120 frames per second")
     if args.max_upload_mb <= 0:
         raise SystemExit(f"--max-upload-mb {args.max_upload_mb}: give a positive size")
     data_dirs = [Path(d).expanduser().resolve() for d in args.data_dir] or [headct.default_cache_dir().resolve()]
     source = "phantom" if args.phantom else "own" if args.ct is not None else "headct"
     return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
                    max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
-                   work_dir=args.work_dir, records=args.records)
+                   navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records)
 
 
 def path_allowed(path: Path, folders) -> bool:
@@ -213,7 +219,12 @@ class VolumeCuttingApp(TrameApp):
         self._last_table_refresh = 0.0
         self._table_refresh_task = None
         self.progressive = None
-        self.timing = {"events": deque(maxlen=20000), "renders": deque(maxlen=20000)}
+        # For tests and benchmarks (vc_diagnostics): events as applied, when each 3D frame began, each 3D frame
+        # (window, start ms, duration ms, width, height, pixels per ray each way) and when the data was ready.
+        # The Ready message of data whose first picture has not reached the page yet (its 3D view had no size).
+        self._ready_when_shown = None
+        self.timing = {"events": deque(maxlen=20000), "renders": deque(maxlen=20000), "frames": deque(maxlen=20000),
+                       "ready_at": None}
         self.server.add_protocol_to_configure(lambda protocol: protocol.registerLinkProtocol(ConnectionWatch(self)))
         self._register_views()
         self._initialize_state()
@@ -288,7 +299,7 @@ class VolumeCuttingApp(TrameApp):
         area = self._three_d_factory.areas[THREE_D_TAG]
         self.progressive = rendering.ProgressiveRendering(area, self._three_d_factory.schedulers[THREE_D_TAG],
                                                           self.options.navigate_scale, self.options.drill_scale,
-                                                          self.options.refine_delay_s)
+                                                          self.options.refine_delay_s, navigate_fps=self.options.navigate_fps)
         self.drill.depth_sources = lambda: [area.main_view.surface_depth, area.preview_view.surface_depth]
         adapter = rca_view.view_adapter
         handle = adapter.on_interaction
@@ -306,25 +317,42 @@ class VolumeCuttingApp(TrameApp):
                                           event.get("x"), event.get("y")))
 
         adapter.on_interaction = on_interaction
+        self._three_d_factory.schedulers[THREE_D_TAG].on_frame_sent = self._three_d_frame_sent
         interactor = area.main_view.interactor()
         for event in ("LeftButtonPressEvent", "MiddleButtonPressEvent", "RightButtonPressEvent"):
             interactor.AddObserver(event, lambda *_: self.progressive.button_pressed(), 10.0)
         for event in ("LeftButtonReleaseEvent", "MiddleButtonReleaseEvent", "RightButtonReleaseEvent"):
             # Before the interactor style, which may take the event for itself.
             interactor.AddObserver(event, lambda *_: self.progressive.button_released(), 10.0)
-        for name, window in (("main", area.main_view.render_window()), ("preview", area.preview_view.render_window())):
+        for name, view in (("main", area.main_view), ("preview", area.preview_view)):
+            window = view.render_window()
             window.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: self._render_started())
-            window.AddObserver(vtk.vtkCommand.EndEvent, lambda w, _e, name=name: self._render_ended(name, w))
+            window.AddObserver(vtk.vtkCommand.EndEvent, lambda w, _e, name=name, view=view: self._render_ended(name, view))
         self.state.vc_three_d_area = get_view_trame_id(self.server, area.main_view)
+
+    def _three_d_frame_sent(self) -> None:
+        """The page says Ready only once the data's first picture is on its way: never over a black view."""
+        if self._ready_when_shown is None or not self.session.has_data or not self._three_d_factory.areas[THREE_D_TAG].sized:
+            return
+        text, self._ready_when_shown = self._ready_when_shown, None
+        self.timing["ready_at"] = time.time() * 1000.0
+        with self.state:
+            self.state.vc_status = text
 
     def _render_started(self) -> None:
         self._render_start = time.time() * 1000.0
         self.timing["renders"].append(self._render_start)
 
-    def _render_ended(self, name, window) -> None:
+    def _render_ended(self, name, view) -> None:
+        width, height = view.render_window().GetSize()
+        duration = time.time() * 1000.0 - self._render_start
+        actor = view.volume_cut_displayable_manager.GetVolumeActor(self.session.cut_node) if self.session.has_data else None
+        sample_distance = actor.GetMapper().GetLastImageSampleDistance() if actor is not None else 1
+        self.timing["frames"].append((name, self._render_start, duration, width, height, sample_distance))
         if TRACE:
-            width, height = window.GetSize()
-            print(f"[render] {name} {width}x{height} {time.time() * 1000.0 - self._render_start:.0f} ms", flush=True)
+            print(f"[render] {name} {width}x{height} {duration:.0f} ms, a ray per {sample_distance}x{sample_distance} "
+                  "pixels", flush=True)
+
 
     def reset_camera(self) -> None:
         if self.session.has_data:
@@ -553,7 +581,8 @@ class VolumeCuttingApp(TrameApp):
         @ctrl.trigger("vc_diagnostics")
         def diagnostics():
             # For tests and benchmarks: what the server did and which mode it is in.
-            return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]), "mode": self.drill.mode}
+            return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]),
+                    "frames": list(self.timing["frames"]), "ready_at": self.timing["ready_at"], "mode": self.drill.mode}
 
         @ctrl.trigger("vc_load")
         async def load(source):
@@ -772,6 +801,7 @@ class VolumeCuttingApp(TrameApp):
             return
         with state:
             state.vc_busy, state.vc_error, state.vc_progress, state.vc_status = True, "", 0, "Starting"
+        self._ready_when_shown = None
         self.drill.end_stroke()
         try:
             for fraction, text in self.session.loading(source, **options):
@@ -780,7 +810,15 @@ class VolumeCuttingApp(TrameApp):
                 # Let the page show the progress before the next step holds the server.
                 await asyncio.sleep(0.05)
             self._refresh_after_data()
-            state.vc_status = "Ready: " + self.session.description
+            with state:
+                state.vc_progress, state.vc_status = 98, "Drawing the first picture"
+            # A quick, coarse first picture now (the full one follows): the page never says Ready over a black view.
+            # A page whose 3D view has no size yet (still opening) is told once its first frame is sent.
+            if await self.progressive.first_frame():
+                self.timing["ready_at"] = time.time() * 1000.0
+                state.vc_status = "Ready: " + self.session.description
+            else:
+                self._ready_when_shown = "Ready: " + self.session.description
             state.vc_upload_message = ""  # a refused upload's message no longer applies to the data shown
         except (SessionError, owndata.InputError, headct.HeadCTUnavailableError, OSError) as error:
             state.vc_error = self._with_upload_names(str(error))

@@ -17,11 +17,22 @@ changed since that window last drew. trame-rca streams whichever window
 drew last (``ProgressiveArea``); JPEG quality drops while interacting and
 rises for still frames (trame-rca's interactive and still qualities).
 ``ProgressiveRendering`` decides which window draws.
+
+While the camera moves, every pixel changes, so no cached image helps: the
+preview then asks for interactive frames (its window's DesiredUpdateRate at
+``navigate_fps``, as VTK's interactor styles do), and the product's mapper
+casts one ray per few pixels, as many as fit in the frame's time, without
+ambient occlusion (``vtkVolumeCutVolumeMapper``'s progressive refinement).
+Every still frame (the drill preview at rest, the main window's refinement)
+casts every pixel at full quality. ``ProgressiveScheduler`` sends each frame
+to the page before it draws the next, so a frame never waits behind a newer
+one.
 """
 
 from __future__ import annotations
 
 import asyncio
+from time import monotonic
 
 import numpy as np
 
@@ -38,6 +49,15 @@ from vtkmodules.util.numpy_support import vtk_to_numpy
 from .views import VolumeCutThreeDView
 
 PREVIEW_SUFFIX = "Preview"
+# The render window's DesiredUpdateRate of still frames (VTK's interactor default).
+STILL_UPDATE_RATE = 0.0001
+# The coarsest interactive frame still casts this many rays across the view's width: on a loaded machine the
+# mapper would otherwise go to one ray per 16 x 16 pixels (32 x 24 rays at 512 x 384), a blur in which the
+# skull's outline is lost, to save milliseconds that the rest of the frame (drawing, reading back, encoding) spends anyway.
+MINIMUM_RAYS_ACROSS = 64
+# Between two frames the server takes the events that arrived meanwhile, so
+# that the next frame shows where the mouse is now, not where it was.
+EVENT_GAP_S = 0.004
 
 
 def camera_signature(camera) -> tuple:
@@ -96,6 +116,56 @@ class ProgressiveArea(RcaWindow):
         interactor.InvokeEvent(vtk.vtkCommand.WindowResizeEvent)
 
 
+class ProgressiveScheduler(RcaImageRenderScheduler):
+    """trame-rca's image scheduler, with each frame encoded and sent before the next is drawn.
+
+    trame-rca encodes on a thread and sends from another task, which runs only
+    when the event loop is free; drawing is synchronous, so on a busy
+    machine a frame drawn while the mouse moved waited behind the next
+    frame's drawing (up to seconds on 2 shared cores) before it left. Here
+    the loop awaits the encoding (the loop takes events meanwhile), sends
+    the frame, then leaves ``EVENT_GAP_S`` for the events that arrived
+    during the frame. Built on trame-rca 2.11's scheduler internals
+    (``_render``, ``_render_frame``), which the project pins.
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._frame_sent = asyncio.Event()
+        # Called after each frame left for the page.
+        self.on_frame_sent = lambda: None
+
+    async def send_frame(self, timeout_s: float) -> bool:
+        """Draw a frame and wait until it has been sent to the page (False if that took longer than ``timeout_s``)."""
+        self._frame_sent.clear()
+        self.schedule_render()
+        try:
+            await asyncio.wait_for(self._frame_sent.wait(), timeout_s)
+        except asyncio.TimeoutError:
+            return False
+        return True
+
+    async def _render(self):
+        while not self._is_closing:
+            await self._request_event.wait()
+            if self._is_closing:
+                break
+            self._request_event.clear()
+            started = monotonic()
+            image, meta, m_time = await self._encode_frame(self._interactive_quality)
+            if m_time >= self._last_push_time_ms and self._push_callback is not None:
+                self._last_push_time_ms = m_time
+                self._push_callback(image, meta)
+            self._frame_sent.set()
+            self.on_frame_sent()
+            await asyncio.sleep(max(EVENT_GAP_S, self._target_period_s - (monotonic() - started)))
+
+    def _encode_frame(self, quality):
+        np_img, cols, rows = self._rca.img_cols_rows
+        return asyncio.get_running_loop().run_in_executor(self._encode_pool, self._rca_encoder.encode, np_img, cols,
+                                                          rows, quality)
+
+
 class ProgressiveThreeDViewFactory(RemoteViewFactory):
     """trame-slicer's remote 3D view factory, with the preview window and ``ProgressiveArea``."""
 
@@ -115,7 +185,7 @@ class ProgressiveThreeDViewFactory(RemoteViewFactory):
         cursor = f"{view_id}_active_view_cursor"
         self._server.state.setdefault(cursor, CursorId.DEFAULT.value)
         area = ProgressiveArea(main_view, preview, self._server.state, cursor)
-        scheduler = RcaImageRenderScheduler(window=area, interactive_quality=self._interactive_quality,
+        scheduler = ProgressiveScheduler(window=area, interactive_quality=self._interactive_quality,
                                             rca_encoder=self._rca_encoder, target_fps=self._target_fps)
         trame_id = get_view_trame_id(self._server, main_view)
         with ViewLayout(self._server, template_name=trame_id) as layout:
@@ -139,25 +209,30 @@ class ProgressiveThreeDViewFactory(RemoteViewFactory):
 class ProgressiveRendering:
     """Which window of the 3D view draws, and when the main window refines.
 
-    * While the camera moves (drags, wheel zoom, camera buttons) and right
-      after the view is resized, the preview draws at ``navigate_scale``
-      (every pixel is recast then).
+    * While the camera moves (drags, wheel zoom, camera buttons), right
+      after the view is resized and for the first picture of new data, the
+      preview draws interactive frames at ``navigate_scale``: the mapper
+      casts as many rays as fit in 1 / ``navigate_fps`` seconds, without
+      ambient occlusion.
     * While the user drills, the preview draws at ``drill_scale``.
     * At rest, the preview is first brought up to date at ``drill_scale`` if
-      the camera moved (so that the next stroke recasts only what it
-      changes), then, ``delay_s`` after the last interaction, the main
-      window draws at full resolution.
+      the camera moved (a still frame, so that the next stroke recasts only
+      what it changes), then, ``delay_s`` after the last interaction, the
+      main window draws at full resolution and full quality.
     """
 
     def __init__(self, area: ProgressiveArea, scheduler, navigate_scale: float, drill_scale: float, delay_s: float,
-                 interactive_quality: int = 60, still_quality: int = 90):
+                 interactive_quality: int = 60, still_quality: int = 90, navigate_fps: float = 20.0):
         self.area = area
         self.scheduler = scheduler
         self.interactive_quality = interactive_quality
         self.still_quality = still_quality
         self.navigate_scale = navigate_scale
         self.drill_scale = drill_scale
+        self.navigate_fps = navigate_fps
         self.delay_s = delay_s
+        self._draft = False
+        self._stroke_sample_distance = None
         self._timer = None
         self._navigating = False
         self._stroke = False
@@ -185,6 +260,8 @@ class ProgressiveRendering:
 
     def stroke_started(self) -> None:
         self._cancel()
+        # A stroke right after a camera move starts from still frames: its frames keep the mapper's own settings.
+        self._set_draft(False)
         self._stroke = True
         self._show(True, self.drill_scale)
 
@@ -214,18 +291,39 @@ class ProgressiveRendering:
             return
         self._cancel()
         self._navigating = self._button_down
-        self._show(True, self.navigate_scale)
+        self._show(True, self.navigate_scale, draft=True)
         if not self._button_down:
             # Wheel zoom, camera buttons: no release comes; rest once this coarse frame is drawn.
             self._after_preview = self._rest
 
     def _resized(self) -> None:
         if self.interacting:
-            self._show(True, self.area.preview_scale)
+            self._show(True, self.area.preview_scale, draft=self._draft)
             return
         self._cancel()
-        self._show(True, self.navigate_scale)
+        self._show(True, self.navigate_scale, draft=True)
         self._after_preview = self._rest
+
+    async def first_frame(self, timeout_s: float = 30.0) -> bool:
+        """New data is in the scene: send its first picture now, as an interactive frame (quick), then refine.
+
+        The first frame of a mapper also prepares its scene (bricks, empty
+        space, segment surfaces), so the loading step that awaits this takes
+        that time while the page still shows progress, and the picture is in
+        the page when it says Ready. False when the page has not said how
+        large the view is (the preview window still draws once, unseen, to
+        prepare its scene: the picture its first size draws is then quick) or
+        the frame took longer than ``timeout_s``.
+        """
+        if not self.area.sized:
+            self._set_draft(True)
+            self.area.preview_view.render_window().Render()
+            return False
+        self._cancel()
+        self._show(True, self.navigate_scale, draft=True)
+        sent = await self.scheduler.send_frame(timeout_s)
+        self._rest()
+        return sent
 
     def _sync_camera(self, *_):
         """The preview looks through the main window's camera."""
@@ -236,7 +334,7 @@ class ProgressiveRendering:
         target.SetClippingRange(source.GetClippingRange())
 
     def _preview_drawn(self, *_):
-        if self.area.preview_scale == self.drill_scale:
+        if self.area.preview_scale == self.drill_scale and not self._draft:
             self._preview_signature = (camera_signature(self.area.main_view.renderer().GetActiveCamera()), self.area.size)
         follow, self._after_preview = self._after_preview, None
         if follow is not None:
@@ -251,15 +349,36 @@ class ProgressiveRendering:
             self._timer.cancel()
             self._timer = None
 
-    def _show(self, preview: bool, scale: float | None = None) -> None:
+    def _show(self, preview: bool, scale: float | None = None, draft: bool = False) -> None:
         if scale is not None:
             self.area.set_preview_scale(scale)
+        self._set_draft(preview and draft)
         self.area.use_preview = preview
         # One encoding per frame (no second, finer one of the same image): coarse while
         # interacting, fine at rest.
         quality = self.interactive_quality if preview else self.still_quality
         self.scheduler.update_quality(quality, quality)
         self.scheduler.schedule_render()
+
+    def _set_draft(self, draft: bool) -> None:
+        """Interactive frames in the preview, or still ones (a stroke's rate is the displayable manager's)."""
+        if draft == self._draft or self._stroke:
+            # During a stroke the flag stays as the mapper is, so that the call after the stroke restores it.
+            return
+        self._draft = draft
+        window = self.area.preview_view.render_window()
+        coarsest = max(1, round(window.GetSize()[0] / MINIMUM_RAYS_ACROSS))
+        for volume in self.area.preview_view.renderer().GetVolumes():
+            mapper = volume.GetMapper()
+            if not isinstance(mapper, slicer.vtkVolumeCutVolumeMapper):
+                continue
+            # The cap holds for the camera's motion only: a stroke's frames keep the mapper's own.
+            if draft:
+                self._stroke_sample_distance = mapper.GetMaximumImageSampleDistance()
+                mapper.SetMaximumImageSampleDistance(min(coarsest, self._stroke_sample_distance))
+            elif self._stroke_sample_distance is not None:
+                mapper.SetMaximumImageSampleDistance(self._stroke_sample_distance)
+        window.SetDesiredUpdateRate(self.navigate_fps if draft else STILL_UPDATE_RATE)
 
     def _rest(self) -> None:
         self._cancel()
