@@ -16,7 +16,9 @@ object whose brightness differs by more than 6/255, and the share of pixel
 triples whose brightness bends by more than 3/255 (the normals test's
 seams). The rim, where the wall meets the ball's surface at an angle, is a
 true edge, not a facet: pairs across it are left out (pairs are counted
-within the wall and within the surface around the hole). Bounds: the cut
+within the wall and within the surface around the hole). So is, with
+thin-bone shading, the rim's red band, whose tint turns from red to bone
+within a few pixels by design as the lip thickens. Bounds: the cut
 object's steps at most the uncut surface's plus 0.5 %, the wall's kinks at
 most the uncut surface's plus 0.5 %; on the CPU reference and on the GLSL
 path (here llvmpipe), which must also agree with each other.
@@ -63,7 +65,11 @@ def figures(path, settings):
     uncut = np.all(np.isfinite(uncut_points), axis=2)
     rgb, points, _ = render_close_up(burr_hole(), path=path, **settings)
     cut = np.all(np.isfinite(points), axis=2)
-    wall = burr_wall(points)
+    if settings["thin_bone"]:
+        # The pixels the tint changes, by the same view without it.
+        untinted = render_close_up(burr_hole(), path=path, **dict(settings, thin_bone=False))[0]
+        cut &= np.all(rgb == untinted, axis=2)
+    wall = burr_wall(points) & cut
     from_hole = np.linalg.norm(np.where(cut[..., None], points, 0.0) - HOLE_CENTRE, axis=2)
     around = cut & (from_hole > HOLE_RADIUS + 0.5 * SPACING)
     return {
