@@ -47,7 +47,7 @@ public:
   /// Darkening at full occlusion.
   static constexpr double Strength = 0.9;
   /// Depth (as a share of a point's distance from the shaded point) at which a point counts fully.
-  static constexpr double RampWidth = 0.25;
+  static constexpr double RampWidth = 0.15;
   static constexpr int Points = 14;
 
   vtkVolumeCutAmbientOcclusion(const vtkVolumeCutRayScene& scene, const vtkVolumeCutSampleClassifier& classifier)

@@ -75,7 +75,8 @@ float occlusion(vec3 index, vec3 normal)
       evaluateObject(s);
       if (visible(s))
       {
-        float width = max(voxel, 0.25 * reach * ambientOcclusionRadius);
+        // RampWidth in vtkVolumeCutAmbientOcclusion.h.
+        float width = max(voxel, 0.15 * reach * ambientOcclusionRadius);
         occupied += smoothstep(0.0, 1.0, occlusionDepth(s) / width);
       }
     }
