@@ -42,6 +42,7 @@ struct vtkVolumeCutRay
   double OriginWorld[3];
   double DirectionWorld[3]; // unit
   double View[3];           // towards the eye
+  double ViewAxis[3];       // the camera's axis, towards the eye: the same for every ray of an image
   double Origin[3];         // IJK
   double Direction[3];      // IJK per mm
   double VoxelsPerMillimetre = 1.0;

@@ -247,7 +247,7 @@ void vtkVolumeCutRayCastProgram::SetUniforms(const vtkVolumeCutRayCaster::SceneV
   // Cell pieces of one interval in the exact hidden-border test: a uniform
   // bound (a constant would have drivers unroll the loop).
   program->SetUniformi("intervalPieces", 16);
-  program->SetUniformi("occlusionDirections", 7);
+  program->SetUniformi("occlusionPoints", 14);
   const int planeCount = std::min(static_cast<int>(view.Planes.size()), 6);
   float planes[6][4] = {};
   for (int p = 0; p < planeCount; ++p)

@@ -192,10 +192,11 @@ public:
   ///@{
   /**
    * Ambient occlusion, a depth cue that makes cavities read in a still
-   * image: each surface point is darkened by the share of 14 points around
+   * image: each surface point is darkened by how much of 14 points around
    * it, up to AmbientOcclusionRadius (mm) away over its normal's
-   * hemisphere, that lie in visible material (cuts removed). Off by default;
-   * radius 6 mm.
+   * hemisphere, lies in visible material (cuts removed), each point weighed
+   * by its depth in the material so that the term varies smoothly over a
+   * surface (vtkVolumeCutAmbientOcclusion). Off by default; radius 6 mm.
    */
   vtkSetMacro(AmbientOcclusion, bool);
   vtkGetMacro(AmbientOcclusion, bool);

@@ -52,6 +52,18 @@ void vtkVolumeCutRayMarcher::Cast(const vtkVolumeCutRayScene& scene, const doubl
   {
     ray.View[axis] = -ray.DirectionWorld[axis];
   }
+  // The ray through the image's centre, reversed (as the GLSL computes it).
+  const double centreNearH[4] = { 0.0, 0.0, -1.0, 1.0 };
+  const double centreFarH[4] = { 0.0, 0.0, 1.0, 1.0 };
+  double centreNear[4];
+  double centreFar[4];
+  Multiply4(ndcToWorld, centreNearH, centreNear);
+  Multiply4(ndcToWorld, centreFarH, centreFar);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    ray.ViewAxis[axis] = centreNear[axis] / centreNear[3] - centreFar[axis] / centreFar[3];
+  }
+  vtkMath::Normalize(ray.ViewAxis);
   TransformPoint(scene.WorldToIJK, ray.OriginWorld, ray.Origin);
   TransformVector(scene.WorldToIJK, ray.DirectionWorld, ray.Direction);
 

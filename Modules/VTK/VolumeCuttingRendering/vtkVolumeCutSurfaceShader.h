@@ -161,7 +161,7 @@ public:
     float alpha = style.Opacity;
     if (this->Scene.AmbientOcclusion)
     {
-      this->Occlusion.Apply(index, normal, rgb);
+      this->Occlusion.Apply(index, normal, ray.ViewAxis, rgb);
     }
     if (this->Scene.ThinBone)
     {

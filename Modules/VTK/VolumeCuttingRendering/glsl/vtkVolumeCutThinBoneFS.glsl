@@ -2,10 +2,38 @@
 // SPDX-License-Identifier: Apache-2.0
 // Thin-bone shading (Morris et al.): bone thinner than thinBoneThickness
 // along the inward normal turns red and translucent
-// (vtkVolumeCutThinBoneShader.h). Replaces the skeleton's VolumeCut::ThinBone::Dec tag.
+// (vtkVolumeCutThinBoneShader.h, which says why the last step is halved).
+// Replaces the skeleton's VolumeCut::ThinBone::Dec tag.
 
 uniform int thinBone;
 uniform float thinBoneThickness;
+
+bool visibleAt(vec3 index)
+{
+  Sample s = sampleAt(0.0);
+  s.index = index;
+  evaluateObject(s);
+  return visible(s);
+}
+
+// Where the material ends between two distances (mm) along the inward
+// direction: in it at inside, out at outside.
+float thinBoneCrossing(vec3 index, vec3 inwardIndex, float inside, float outside)
+{
+  for (int halving = 0; halving < 6; ++halving)
+  {
+    float middle = 0.5 * (inside + outside);
+    if (visibleAt(index + middle * inwardIndex))
+    {
+      inside = middle;
+    }
+    else
+    {
+      outside = middle;
+    }
+  }
+  return 0.5 * (inside + outside);
+}
 
 float measureThickness(int object, vec3 index, vec3 normalWorld)
 {
@@ -18,16 +46,14 @@ float measureThickness(int object, vec3 index, vec3 normalWorld)
   float stepLength = 0.25 / voxelsPerMillimetre;
   for (float travelled = stepLength; travelled < thinBoneThickness; travelled += stepLength)
   {
-    Sample s = sampleAt(0.0);
-    s.index = index + travelled * inwardIndex;
-    if (any(lessThan(s.index, vec3(0.0))) || any(greaterThan(s.index, vec3(dimensions - 1))))
+    vec3 p = index + travelled * inwardIndex;
+    if (any(lessThan(p, vec3(0.0))) || any(greaterThan(p, vec3(dimensions - 1))))
     {
       return thinBoneThickness;
     }
-    evaluateObject(s);
-    if (!visible(s))
+    if (!visibleAt(p))
     {
-      return travelled;
+      return thinBoneCrossing(index, inwardIndex, travelled - stepLength, travelled);
     }
   }
   return thinBoneThickness;

@@ -53,12 +53,16 @@ def _stock_volume(scene, masked):
     return volume
 
 
-def _our_volume(scene, intensities, cut, path):
+def _our_volume(scene, intensities, cut, path, occlusion=False):
     mapper = vc.vtkVolumeCutVolumeMapper()
     mapper.SetInputData(intensities)
     mapper.GetRayCaster().SetIsoValue(scene.iso_value())
+    mapper.GetRayCaster().SetAmbientOcclusion(occlusion)
     mapper.GetRayCaster().AddCutField(cut)
     mapper.SetRequestedRenderPath(path)
+    # The frames are measured, not the first program build on a software
+    # rasterizer (which can pass the default limit there, and draw on the CPU).
+    mapper.SetProgramBuildTimeLimit(600.0)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetUserMatrix(scene.ijk_to_ras())
@@ -99,6 +103,12 @@ def _accuracy(scene, matrix, width, depth, own_normals=None):
     }
     if own_normals is not None:
         result["normal_shading"] = A.summarize(A.normal_errors(reference, own_normals.astype(float), classes))
+        # Within a voxel of a crease (the cube's edges, where a cut meets the
+        # cube or another cut) the sampled fields round the edge: elsewhere a
+        # normal that jumps at the cut field's cells is what shows.
+        away = scene.crease_distance(np.nan_to_num(points.reshape(-1, 3))).reshape(depth.shape) > scene.spacing
+        result["normal_shading_a_voxel_from_creases"] = A.summarize(
+            A.normal_errors(reference, own_normals.astype(float), classes, keep=away))
     return result
 
 
@@ -175,6 +185,18 @@ def mapper(repeats: int) -> list[dict]:
                           stock_name + " (normals from its depth map)", stock["normal_from_depth"]["median"], machine))
     results.append(_entry("CPU reference: normal angle error (shading normals), p95", cpu["normal_shading"]["p95"], "degree",
                           stock_name + " (normals from its depth map)", stock["normal_from_depth"]["p95"], machine))
+    # A median of 0 hides a normal that jumps at the cut field's cells: the
+    # largest error is what a magnified wall shows (issue 28 bounds it by 2
+    # degrees). Over every pixel 3 px from a border it is the rounding of
+    # the cube's edges and of the creases where cuts meet, by the sampled CT
+    # and cut fields; a voxel from any crease it is the surfaces' own.
+    results.append(_entry("CPU reference: normal angle error (shading normals), max, a voxel or more from creases",
+                          cpu["normal_shading_a_voxel_from_creases"]["max"], "degree", "bound (issue 28)", 2.0, machine,
+                          details={"a_voxel_from_creases": cpu["normal_shading_a_voxel_from_creases"],
+                                   "all_3_px_from_borders": cpu["normal_shading"]}))
+    results.append(_entry("CPU reference: normal angle error (shading normals), max, every pixel 3 px from borders (creases included)",
+                          cpu["normal_shading"]["max"], "degree", stock_name + " (normals from its depth map)",
+                          stock["normal_from_depth"]["max"], machine))
     results.append(_entry("CPU reference: normal angle error from its depth map (same metric as the stock mapper), p95",
                           cpu["normal_from_depth"]["p95"], "degree", stock_name + " (normals from its depth map)",
                           stock["normal_from_depth"]["p95"], machine))
@@ -205,11 +227,14 @@ def mapper(repeats: int) -> list[dict]:
             renderer.ResetCameraClippingRange()
             stock_time = _frame_time(window, repeats)
             renderer.RemoveVolume(stock_volume)
-            paths = [("CPU path", vc.vtkVolumeCutVolumeMapper.CPUPath)]
+            paths = [("CPU path", vc.vtkVolumeCutVolumeMapper.CPUPath, False)]
             if dimensions == 256 and size == 512:
-                paths.append((f"OpenGL path on {renderer_name}", vc.vtkVolumeCutVolumeMapper.GPUPath))
-            for label, path in paths:
-                ours = _our_volume(big, big_intensities, big_cut, path)
+                # Ambient occlusion as the application has it (on by default), for its cost.
+                paths.append(("CPU path, ambient occlusion on", vc.vtkVolumeCutVolumeMapper.CPUPath, True))
+                paths.append((f"OpenGL path on {renderer_name}", vc.vtkVolumeCutVolumeMapper.GPUPath, False))
+                paths.append((f"OpenGL path on {renderer_name}, ambient occlusion on", vc.vtkVolumeCutVolumeMapper.GPUPath, True))
+            for label, path, occlusion in paths:
+                ours = _our_volume(big, big_intensities, big_cut, path, occlusion)
                 renderer.AddVolume(ours)
                 # Every frame a full one: the camera moves a little between frames.
                 def full_frames():

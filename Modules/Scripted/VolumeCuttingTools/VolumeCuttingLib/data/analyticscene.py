@@ -228,8 +228,8 @@ class CubeScene:
             normals[sel] = vector / np.linalg.norm(vector, axis=1)[:, None]
         return best_t, best_class, normals
 
-    def classify_points(self, points: np.ndarray, valid: np.ndarray) -> np.ndarray:
-        """Class of rendered surface points by the nearest exact surface."""
+    def surface_distances(self, points: np.ndarray) -> np.ndarray:
+        """Unsigned distances (mm) of points to each exact surface: the cube, then each sphere, then each cylinder."""
         distances = [np.abs(self.cube_distance(points))]
         for sphere in self.spheres:
             distances.append(np.abs(np.linalg.norm(points - np.asarray(sphere.center), axis=1) - sphere.radius))
@@ -239,9 +239,22 @@ class CubeScene:
             rel = points - np.asarray(cylinder.point)
             radial = np.linalg.norm(rel - np.outer(rel @ a, a), axis=1)
             distances.append(np.abs(radial - cylinder.radius))
-        nearest = np.argmin(np.stack(distances, axis=1), axis=1)
+        return np.stack(distances, axis=1)
+
+    def classify_points(self, points: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """Class of rendered surface points by the nearest exact surface."""
+        nearest = np.argmin(self.surface_distances(points), axis=1)
         classes = np.where(nearest == 0, CUBE, CUT).astype(np.int32)
         return np.where(valid, classes, BACKGROUND)
+
+    def crease_distance(self, points: np.ndarray) -> np.ndarray:
+        """How far (mm) surface points are from the scene's creases: the cube's
+        edges, and where two exact surfaces meet (a point this near two
+        surfaces). The CT and the cut fields are sampled: they round a crease
+        over about a voxel, where no normal can be the exact one."""
+        second_surface = np.sort(self.surface_distances(points), axis=1)[:, 1]
+        second_face = np.sort(np.abs(np.abs(points - self.center) - self.half_size), axis=1)[:, 1]
+        return np.minimum(second_surface, second_face)
 
 
 def default_scene(dimensions: int = 64) -> CubeScene:
@@ -415,11 +428,13 @@ def edge_errors(reference: Reference, classes: np.ndarray) -> np.ndarray:
     return _nearest_distance(np.stack([x + 0.5, y + 0.5], axis=1), reference.border_points)
 
 
-def normal_errors(reference: Reference, normals: np.ndarray, classes: np.ndarray, margin: int = 3) -> np.ndarray:
-    """Angles (degrees) between normals and the exact ones, away from borders."""
+def normal_errors(reference: Reference, normals: np.ndarray, classes: np.ndarray, margin: int = 3, keep=None) -> np.ndarray:
+    """Angles (degrees) between normals and the exact ones, away from borders (and only at pixels in keep, if given)."""
     inside_image = np.zeros(classes.shape, bool)
     inside_image[margin:-margin, margin:-margin] = True
     sel = (classes == reference.classes) & (reference.classes != BACKGROUND) & ~near_borders(reference.classes, margin) & inside_image
+    if keep is not None:
+        sel &= keep
     a = normals[sel]
     b = reference.normals[sel]
     ok = np.all(np.isfinite(a), axis=1)

@@ -79,8 +79,9 @@ def close_up_camera():
     return camera
 
 
-def render_close_up(cut):
-    """Colour (rows from the bottom, 0..255), world hit points and shaded normals of the CPU path's still frame."""
+def render_close_up(cut, iso=500.0, occlusion=False, thin_bone=False, path=vc.vtkVolumeCutVolumeMapper.CPUPath):
+    """Colour (rows from the bottom, 0..255), world hit points and shaded normals of one path's still frame
+    (the normals only on the CPU path: None on the GPU's)."""
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
     window.SetSize(WIDTH, WIDTH)
@@ -90,9 +91,11 @@ def render_close_up(cut):
     renderer.SetActiveCamera(camera)
     mapper = vc.vtkVolumeCutVolumeMapper()
     mapper.SetInputData(noisy_ball_ct())
-    mapper.SetRequestedRenderPath(vc.vtkVolumeCutVolumeMapper.CPUPath)
+    mapper.SetRequestedRenderPath(path)
     caster = mapper.GetRayCaster()
-    caster.SetIsoValue(500.0)
+    caster.SetIsoValue(iso)
+    caster.SetAmbientOcclusion(occlusion)
+    caster.SetThinBoneShading(thin_bone)
     if cut is not None:
         caster.AddCutField(cut)
     volume = vtk.vtkVolume()
@@ -100,16 +103,18 @@ def render_close_up(cut):
     volume.SetUserMatrix(ijk_to_ras())
     renderer.AddVolume(volume)
     window.Render()
-    assert mapper.GetLastRenderPath() == vc.vtkVolumeCutVolumeMapper.CPUPath
+    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
     depth = vtk.vtkFloatArray()
     window.GetZbufferData(0, 0, WIDTH - 1, WIDTH - 1, depth)
     depth = numpy_support.vtk_to_numpy(depth).reshape(WIDTH, WIDTH).astype(float)
     rgba = vtk.vtkUnsignedCharArray()
     window.GetRGBACharPixelData(0, 0, WIDTH - 1, WIDTH - 1, 1, rgba)
     rgba = numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4).astype(int)
-    normal_image = vtk.vtkImageData()
-    caster.GetNormalImage(normal_image)
-    normals = numpy_support.vtk_to_numpy(normal_image.GetPointData().GetScalars()).reshape(WIDTH, WIDTH, 3).astype(float)
+    normals = None
+    if path == vc.vtkVolumeCutVolumeMapper.CPUPath:
+        normal_image = vtk.vtkImageData()
+        caster.GetNormalImage(normal_image)
+        normals = numpy_support.vtk_to_numpy(normal_image.GetPointData().GetScalars()).reshape(WIDTH, WIDTH, 3).astype(float)
     points = A.depth_to_points(A.world_to_ndc(camera, WIDTH, WIDTH), depth)
     return rgba[..., :3], points, normals
 
