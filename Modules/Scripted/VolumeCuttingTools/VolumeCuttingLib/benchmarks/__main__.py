@@ -31,6 +31,7 @@ AREAS = {
     "softcut": ("softcut", "softcut_area"),
     "webapp": ("webapp", "webapp"),
     "records": ("records", "records"),
+    "assessment": ("assessment", "assessment"),
 }
 
 
