@@ -13,9 +13,10 @@
     line.style.cssText = "display:flex;align-items:center;gap:6px;font-size:12px;line-height:18px;";
     const name = document.createElement("span");
     name.textContent = reading.name;
-    name.style.cssText = "flex:0 0 40%;overflow:hidden;text-overflow:ellipsis;white-space:nowrap;";
+    name.style.cssText = "flex:0 0 36%;overflow:hidden;text-overflow:ellipsis;white-space:nowrap;";
+    name.title = reading.name;
     const bar = document.createElement("span");
-    bar.style.cssText = "flex:1 1 auto;height:10px;border:1px solid #9e9e9e;border-radius:2px;background:#fafafa;" +
+    bar.style.cssText = "flex:1 1 auto;min-width:30px;height:10px;border:1px solid #9e9e9e;border-radius:2px;background:#fafafa;" +
       "position:relative;overflow:hidden;";
     const fill = document.createElement("span");
     fill.className = "vc-monitor-fill";
@@ -24,8 +25,9 @@
     bar.appendChild(fill);
     const figure = document.createElement("span");
     figure.className = "vc-monitor-figure";
-    figure.style.cssText = `flex:0 0 9.5em;padding:0 4px;border-radius:2px;background:${reading.colour};`;
-    figure.textContent = reading.mm === null ? "not ready" : `${reading.mm.toFixed(2)} mm, ${reading.level}`;
+    figure.style.cssText = "flex:0 0 auto;min-width:10.5em;padding:0 4px;border-radius:2px;white-space:nowrap;" +
+      `font-size:11px;background:${reading.colour};`;
+    figure.textContent = reading.mm === null ? "not ready" : `${reading.mm.toFixed(2)} mm ${reading.level}`;
     line.append(name, bar, figure);
     return line;
   }
