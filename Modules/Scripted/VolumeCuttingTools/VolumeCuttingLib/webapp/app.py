@@ -39,6 +39,7 @@ from trame_slicer.app.ui import create_vertical_slice_view_gutter_ui
 from trame_slicer.core import LayoutManager, SlicerApp
 from trame_slicer.rca_view.rca_view_factory import RemoteViewFactory
 from trame_slicer.views import Layout, LayoutDirection, ViewLayoutDefinition, ViewType
+from trame_client.widgets.core import HtmlElement
 from trame_server.utils.asynchronous import create_task
 from wslink.websocket import LinkProtocol
 
@@ -46,18 +47,20 @@ from ..config import toolconfig
 from ..data import headct, owndata
 from ..feedback import nervemonitor
 from ..jobs import softcutjob
-from . import progress, rendering, sessionrecording, soundfeed, views
+from . import monitormeter, progress, rendering, sessionrecording, soundfeed, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)
 
 WWW = Path(__file__).with_name("www")
 CLIENT_MODULE = {"serve": {"__volumecutting": str(WWW)},
-                 "scripts": ["__volumecutting/volumecutting.js", "__volumecutting/drillsound.js"]}
+                 "scripts": ["__volumecutting/volumecutting.js", "__volumecutting/drillsound.js",
+                             "__volumecutting/monitormeter.js"]}
 
 LAYOUT_ID = "volumecutting"
 # VOLUMECUTTING_WEBAPP_TRACE=1 prints each frame of the 3D view (window, size, time).
 TRACE = os.environ.get("VOLUMECUTTING_WEBAPP_TRACE") == "1"
 THREE_D_TAG = "ThreeD"
+MONITOR_REFRESH_S = 0.1  # the nerve monitor's meter and tint follow the tool at up to 10 Hz
 
 ROLE_ITEMS = [
     {"title": "cuttable", "value": toolconfig.ROLE_CUTTABLE},
@@ -202,11 +205,15 @@ class VolumeCuttingApp(TrameApp):
         self.drill.on_stroke_begin = self._on_stroke_begin
         self.drill.on_stroke_moved = self._on_stroke_moved
         self.drill.on_stroke_end = self._on_stroke_end
-        self.drill.on_hover = lambda: self.progressive.pointer_moved()
+        self.drill.on_hover = self._on_hover
         self.drill.on_depth_changed = self._on_depth_changed
         self.softcut = SoftCutSession(self.session)
         self.sound = soundfeed.SoundFeed(self.session, self.state)
         self.sound.monitor = self._monitor_for_sound
+        # The tint shows where the burr is seen: not while its glyph is hidden (off the bone, or before any pose).
+        self.monitor_meter = monitormeter.MonitorMeter(self.session, self.state, tool_shown=lambda: self.drill.placed)
+        self.drill.on_placed_changed = self._request_monitor_refresh
+        self._monitor_task = None
         self.drill.on_outline_pick = self._on_outline_pick
         self._outline_model = None
         self._pipeline_creator = slicer.vtkMRMLLayerDMPipelineScriptedCreator()
@@ -240,6 +247,24 @@ class VolumeCuttingApp(TrameApp):
         if not self.session.has_data:
             return "silent", 0.0
         return nervemonitor.sound_input(self.session.logic.GetNerveMonitor(self.session.cut_node))
+
+    def _request_monitor_refresh(self, delay_s: float = MONITOR_REFRESH_S) -> None:
+        """The meter and the tint follow the tool at most every ``delay_s``, after the pose that asked."""
+        if self._monitor_task is None or self._monitor_task.done():
+            self._monitor_task = create_task(self._refresh_monitor_later(delay_s))
+
+    async def _refresh_monitor_later(self, delay_s: float) -> None:
+        await asyncio.sleep(delay_s)
+        try:
+            if self.monitor_meter.refresh():
+                self.state.flush()
+        except Exception as error:  # a reading gone bad must not stop the drilling
+            print(f"[monitor] {error}", flush=True)
+            return
+        # The distance fields are built on a worker after a load: look again until every structure is ready.
+        if any(row["mm"] is None for row in self.monitor_meter.shown):
+            self._monitor_task = None
+            self._request_monitor_refresh(0.5)
 
     # ------------------------------------------------------------------ views
 
@@ -392,6 +417,9 @@ class VolumeCuttingApp(TrameApp):
             # which would otherwise render again at every update); the switch and volume are each page's own.
             "vc_sound": self.sound.initial_state(), "vc_sound_config": self.sound.config_state(),
             "vc_sound_on": False, "vc_sound_volume": 0.5, "vc_sound_message": "",
+            # The nerve monitor's meter: small rows, sent when a distance moves > 0.05 mm or a level changes
+            # (www/monitormeter.js draws them, outside the template).
+            "vc_monitor": [],
         })
         state.client_only("vc_client_id", "vc_sound_on", "vc_sound_volume", "vc_sound_message")
         self._update_mode_hint()
@@ -414,12 +442,15 @@ class VolumeCuttingApp(TrameApp):
         self._refresh_tables()
         self.softcut.show_skin(bool(self.state.vc_sc_skin))
         self._refresh_softcut(error="")
+        self.monitor_meter.refresh(force=True)
+        self._request_monitor_refresh()
         self.reset_camera()
 
     def _refresh_tables(self) -> None:
         rows = self.session.segment_rows()
         self.state.vc_segments = [
-            {"id": r.segment_id, "name": r.name, "color": r.color, "role": r.role, "removed": round(r.removed_mm3, 2)}
+            {"id": r.segment_id, "name": r.name, "color": self._own_colour(r.segment_id, r.color), "role": r.role,
+             "removed": round(r.removed_mm3, 2)}
             for r in rows
         ]
         self.state.vc_total_removed = round(sum(r.removed_mm3 for r in rows), 2)
@@ -429,6 +460,11 @@ class VolumeCuttingApp(TrameApp):
         self.state.vc_contacts = self._contact_rows()
         self.report.refresh_counts()
         self._last_table_refresh = time.monotonic()
+
+    def _own_colour(self, segment_id: str, colour: str) -> str:
+        """A segment's colour in the table: its own, not the monitor's tint."""
+        own = self.monitor_meter.tint.tinted.get(segment_id)
+        return colour if own is None else monitormeter.rgb_to_hex(own)
 
     def _contact_rows(self) -> list[dict]:
         if not self.session.has_data:
@@ -485,7 +521,12 @@ class VolumeCuttingApp(TrameApp):
         self.drill.set_glyph(in_contact=False)
         self.sound.stroke_began(self.state.vc_total_removed)
 
+    def _on_hover(self) -> None:
+        self.progressive.pointer_moved()
+        self._request_monitor_refresh()
+
     def _on_stroke_moved(self) -> None:
+        self._request_monitor_refresh()
         # The removed volume follows live, a few times a second.
         if time.monotonic() - self._last_table_refresh > 0.25:
             self.session.update_removed_volumes()
@@ -493,6 +534,7 @@ class VolumeCuttingApp(TrameApp):
 
     def _on_stroke_end(self) -> None:
         self.sound.stroke_ended()
+        self._request_monitor_refresh()
         self.progressive.stroke_ended()
         self._refresh_tables()
         self._jump_slices_to_tool()
@@ -582,7 +624,24 @@ class VolumeCuttingApp(TrameApp):
         def diagnostics():
             # For tests and benchmarks: what the server did and which mode it is in.
             return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]),
-                    "frames": list(self.timing["frames"]), "ready_at": self.timing["ready_at"], "mode": self.drill.mode}
+                    "frames": list(self.timing["frames"]), "ready_at": self.timing["ready_at"], "mode": self.drill.mode,
+                    "monitor": self.monitor_meter.diagnostics()}
+
+        @ctrl.trigger("vc_place_tool")
+        def place_tool(point):
+            # The burr's centre to a point (RAS, mm) in the tool's orientation, as a tracker or a script places it;
+            # for tests and demonstrations of the monitor. Refused during a stroke.
+            if not self.session.has_data or self.session.in_stroke:
+                return False
+            try:
+                moved = self.drill.place_tool_centre(point)
+            except (TypeError, ValueError) as error:
+                print(f"[place tool] {error}", flush=True)
+                return False
+            self.monitor_meter.refresh()
+            self._jump_slices_to_tool()  # the slice views show the structures around the burr, tinted
+            self.state.flush()
+            return moved
 
         @ctrl.trigger("vc_load")
         async def load(source):
@@ -629,6 +688,7 @@ class VolumeCuttingApp(TrameApp):
 
         @ctrl.trigger("vc_export")
         def export(kind):
+            self.monitor_meter.restore_colours()  # the files keep the segments' own colours, not the tint
             try:
                 path = self.session.export(kind)
             except SessionError as error:
@@ -1031,6 +1091,8 @@ class VolumeCuttingApp(TrameApp):
                      "hold Shift to drill twice as deep. Restore mode adds bone back.", classes="text-caption")
             html.Div("Undo steps: {{ vc_undo_count }}, redo steps: {{ vc_redo_count }}", classes="text-caption mt-1")
             self._sound_controls()
+            # Drawn by www/monitormeter.js from vc_monitor, outside the template (see there).
+            HtmlElement("vc-monitor-meter", raw_attrs=['data-testid="monitor-meter"'])
             with html.Div(v_if="vc_contacts.length", classes="mt-2", raw_attrs=['data-testid="contacts"']):
                 # The logic's contact table is a record of the session: undo takes the cut back, not the contact.
                 html.Div("Touched so far (structures the tool may not cut; undo keeps this record):",

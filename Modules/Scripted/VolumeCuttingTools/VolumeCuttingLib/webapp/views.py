@@ -289,6 +289,7 @@ class DrillController:
         self.on_hover = lambda: None
         self.on_depth_changed = lambda depth: None
         self.on_outline_pick = lambda point: None
+        self.on_placed_changed = lambda: None  # the glyph shown or hidden: the tool is over the bone or not
         # Where the surface under the mouse is read: the views' SurfaceDepth (the freshest is used).
         self.depth_sources = lambda: []
         # Whether the tool is over the surface (its glyph shows in every view) and touches a structure it may not cut.
@@ -314,13 +315,33 @@ class DrillController:
     def set_glyph(self, placed: bool | None = None, in_contact: bool | None = None) -> None:
         """Show or hide the tool's glyph, in contact colour or not, in every view."""
         changed = False
-        if placed is not None and placed != self.placed:
+        placed_changed = placed is not None and placed != self.placed
+        if placed_changed:
             self.placed, changed = placed, True
         if in_contact is not None and in_contact != self.in_contact:
             self.in_contact, changed = in_contact, True
         if changed:
             for pipeline in self.pipelines:
                 pipeline.UpdateFromMRML()
+        if placed_changed:
+            self.on_placed_changed()
+
+    def place_tool_centre(self, point) -> bool:
+        """Move the burr's centre to ``point`` (RAS, mm) in the tool's present orientation, without cutting."""
+        centre = [float(v) for v in point] if isinstance(point, (list, tuple)) else []
+        if len(centre) != 3 or not all(math.isfinite(v) for v in centre):
+            raise ValueError(f"Tool position {point!r} is not three numbers (RAS, mm)")
+        if self.session.in_stroke:
+            return False
+        pose = vtk.vtkMatrix4x4()
+        transform = self.session.tool_node.GetParentTransformNode()
+        if transform is not None:
+            transform.GetMatrixTransformToWorld(pose)
+        for row in range(3):
+            pose.SetElement(row, 3, centre[row])
+        moved = self.session.move_tool(pose)
+        self.set_glyph(placed=True)
+        return moved
 
     def end_stroke(self) -> bool:
         """End any open stroke (pointer released, lost, the page gone): what was cut stays."""
