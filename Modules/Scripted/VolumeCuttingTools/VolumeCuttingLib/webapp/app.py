@@ -556,6 +556,9 @@ class VolumeCuttingApp(TrameApp):
         if not self.session.has_data:
             return
         step()
+        if self.progressive is not None:
+            # A frame drawn before the step must not stand as the view at rest.
+            self.progressive.content_changed()
         self.state.vc_contact, self.state.vc_contact_fix = "", None
         self.state.vc_sc_status = ""
         self.drill.set_glyph(in_contact=False)

@@ -269,6 +269,14 @@ class ProgressiveRendering:
         self._stroke = False
         self._rest()
 
+    def content_changed(self) -> None:
+        """The cut changed without a stroke (undo, redo): both windows draw it anew, the preview first, then the main window."""
+        if self.interacting:
+            return
+        self._cancel()
+        self._preview_signature = None
+        self._rest()
+
     def pointer_moved(self) -> None:
         """The drill hovers over the bone: its glyph moves in the drill preview, which refines at rest."""
         if self.interacting:
