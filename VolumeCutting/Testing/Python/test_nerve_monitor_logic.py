@@ -45,6 +45,7 @@ def test_the_logic_monitors_the_protected_nerve_as_the_tool_moves():
         # What the drill sound mixes in: a level it knows, the rate the monitor fires at.
         sound_level, sound_rate = nervemonitor.sound_input(monitor)
         assert sound_level in drillsound.MONITOR_LEVELS and sound_rate == reading["firing_rate_hz"]
+        assert nervemonitor.nearest_mm(monitor) == reading["distance_mm"]  # the drill sound's bone ahead
         sounds.append(sound_level)
         expected = NERVE_END_X - x - BURR_RADIUS
         assert abs(reading["distance_mm"] - expected) < 0.1, (x, reading)
@@ -54,6 +55,7 @@ def test_the_logic_monitors_the_protected_nerve_as_the_tool_moves():
     assert levels[0] == "silent" and levels[-1] == "contact"
     assert [level for n, level in enumerate(sounds) if n == 0 or level != sounds[n - 1]] == list(drillsound.MONITOR_LEVELS)
     assert nervemonitor.sound_input(None) == ("silent", 0.0)
+    assert nervemonitor.nearest_mm(None) == float("inf")
     assert [level for n, level in enumerate(levels) if n == 0 or level != levels[n - 1]] == list(nervemonitor.LEVEL_NAMES)
     # One event per change of level (the first reading, from "not ready", included).
     assert changes["n"] == len(nervemonitor.LEVEL_NAMES)

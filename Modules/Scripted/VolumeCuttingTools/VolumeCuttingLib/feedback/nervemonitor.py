@@ -93,6 +93,12 @@ def sound_input(monitor) -> tuple[str, float]:
     return SOUND_LEVELS[reading["level"]], float(reading["firing_rate_hz"])
 
 
+def nearest_mm(monitor) -> float:
+    """The smallest distance (mm) from the tool's surface to a monitored structure; inf while none is ready."""
+    distances = [r["distance_mm"] for r in readings(monitor).values() if r["distance_mm"] is not None] if monitor else []
+    return min(distances, default=math.inf)
+
+
 def monitor_for(logic, cut_node, segment_ids=None, wait: bool = True):
     """The cut node's monitor from the module logic, watching ``segment_ids`` (None: the protected segments).
 

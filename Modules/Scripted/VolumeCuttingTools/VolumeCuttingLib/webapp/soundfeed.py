@@ -8,8 +8,9 @@ asking the logic for it at 50 Hz would cost the server tens of ms a tick
 while the field changes. The bone ahead of the burr: the renderer
 measures wall thickness only inside its shader (vtkVolumeCutThinBoneShader,
 private to the ray caster), with no per-stroke readout, so its stand-in here
-is the distance from the burr's surface to the nearest voxel of a protected
-segment (the bone left between the burr and what it must spare).
+is the nerve monitor's distance from the burr's surface to the nearest
+monitored structure (the bone left between the burr and what it must spare),
+from ``nearest_structure_mm`` (a callable; none until one is connected).
 The nerve monitor's level and rate come from ``monitor`` (a callable giving
 ``(level, rate_hz)``), silent until one is connected.
 """
@@ -21,82 +22,11 @@ import dataclasses
 import math
 import time
 
-import numpy as np
-import vtk
 from trame_server.utils.asynchronous import create_task
-from vtkmodules.util import numpy_support
 
 from ..feedback import drillsound
 
 PERIOD_S = 1.0 / 75.0  # 75 Hz: above the 50 Hz asked for, with room for ticks a busy event loop delays
-
-
-class ProtectedDistance:
-    """Distance (mm) from a point to the nearest voxel centre of the cut node's protected segments.
-
-    Built once per set of protected segments (the boundary voxels of their
-    labelmaps in a point locator), then a query costs microseconds. Voxel
-    centres: the distance is short of the segment's surface by up to half a
-    voxel diagonal.
-    """
-
-    def __init__(self):
-        self._key = None
-        self._locator = None
-        self._points = None
-
-    def _build(self, segmentation_node, segment_ids) -> None:
-        points = []
-        segmentation = segmentation_node.GetSegmentation()
-        for segment_id in segment_ids:
-            segment = segmentation.GetSegment(segment_id)
-            image = segment.GetRepresentation("Binary labelmap") if segment is not None else None
-            if image is None or image.GetPointData().GetScalars() is None:
-                continue
-            dims = image.GetDimensions()
-            labels = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(dims[2], dims[1], dims[0])
-            inside = labels == segment.GetLabelValue()
-            # Boundary voxels: inside, with a face neighbour outside (or at the image's edge).
-            padded = np.pad(inside, 1)
-            interior = inside.copy()
-            for axis in range(3):
-                for shift in (-1, 1):
-                    interior &= np.roll(padded, shift, axis=axis)[1:-1, 1:-1, 1:-1]
-            k, j, i = np.nonzero(inside & ~interior)
-            if not len(i):
-                continue
-            extent = image.GetExtent()
-            ijk = np.stack([i + extent[0], j + extent[2], k + extent[4], np.ones_like(i)], axis=1).astype(float)
-            matrix = vtk.vtkMatrix4x4()
-            image.GetImageToWorldMatrix(matrix)
-            transform = np.array([[matrix.GetElement(r, c) for c in range(4)] for r in range(4)])
-            points.append((ijk @ transform.T)[:, :3])
-        if not points:
-            self._locator = None
-            return
-        vtk_points = vtk.vtkPoints()
-        vtk_points.SetData(numpy_support.numpy_to_vtk(np.concatenate(points), deep=True))
-        polydata = vtk.vtkPolyData()
-        polydata.SetPoints(vtk_points)
-        self._points = polydata
-        self._locator = vtk.vtkStaticPointLocator()
-        self._locator.SetDataSet(polydata)
-        self._locator.BuildLocator()
-
-    def distance(self, segmentation_node, segment_ids, point) -> float:
-        """Distance (mm) from ``point`` (RAS) to the nearest protected voxel; inf without any."""
-        key = (segmentation_node.GetID() if segmentation_node else None, tuple(segment_ids),
-               segmentation_node.GetSegmentation().GetMTime() if segmentation_node else 0)
-        if key != self._key:
-            self._key = key
-            if segmentation_node is None or not segment_ids:
-                self._locator = None
-            else:
-                self._build(segmentation_node, segment_ids)
-        if self._locator is None:
-            return math.inf
-        closest = self._locator.FindClosestPoint(point)
-        return math.dist(point, self._points.GetPoint(closest))
 
 
 class SoundFeed:
@@ -107,7 +37,7 @@ class SoundFeed:
         self.state = state
         self.config = config or drillsound.SoundConfig()
         self.meter = drillsound.RemovalRateMeter(window_s=0.25)
-        self.protected = ProtectedDistance()
+        self.nearest_structure_mm = lambda: math.inf
         self.monitor = lambda: ("silent", 0.0)
         self.drill_on = False
         self._task = None
@@ -124,16 +54,10 @@ class SoundFeed:
         return dataclasses.asdict(self.config)
 
     def bone_ahead_mm(self) -> float:
-        """The stand-in for the bone left ahead: burr surface to the nearest protected voxel (mm)."""
-        session = self.session
-        transform = session.tool_node.GetParentTransformNode() if session.has_data else None
-        if transform is None:
+        """The stand-in for the bone left ahead: the burr's surface to the nearest monitored structure (mm)."""
+        if not self.session.has_data:
             return math.inf
-        pose = vtk.vtkMatrix4x4()
-        transform.GetMatrixTransformToWorld(pose)
-        centre = [pose.GetElement(r, 3) for r in range(3)]
-        distance = self.protected.distance(session.segmentation, list(session.cut_node.GetProtectedSegmentIDs()), centre)
-        return max(0.0, distance - session.tool_node.GetCuttingRadius())
+        return max(0.0, self.nearest_structure_mm())
 
     def parameters(self) -> drillsound.SoundParameters:
         if not self.session.has_data:
