@@ -174,7 +174,7 @@ class AppServer:
             self.process.wait(timeout=15)
         except subprocess.TimeoutExpired:
             self.process.kill()
-            self.process.wait(timeout=15)
+            self.process.wait(timeout=120)  # a loaded machine takes a while to unmap a large scan
 
     def log_tail(self, lines: int = 40) -> str:
         try:
