@@ -138,7 +138,8 @@ def test_the_nerve_monitor_is_recorded_with_the_poses_and_agrees_with_the_poses(
     recomputed = graded.trainee.recomputed[target_name]
     print(f"{target_name}: min distance monitor {m[f'safety.min_distance_mm.{target_name}']:.3f} mm, "
           f"recomputed {recomputed.min():.3f} mm; largest difference "
-          f"{m[f'safety.monitor_minus_poses_max_abs_mm.{target_name}']:.3f} mm, mean {m[f'safety.monitor_minus_poses_mean_mm.{target_name}']:.3f} mm")
+          f"{m[f'safety.monitor_minus_poses_max_abs_mm.{target_name}']:.3f} mm, "
+          f"mean {m[f'safety.monitor_minus_poses_mean_mm.{target_name}']:.3f} mm")
     assert m[f"safety.min_distance_mm.{target_name}"] == pytest.approx(recomputed.min(), abs=tolerance)
     assert m[f"safety.min_distance_mm.{target_name}"] == pytest.approx(0.6, abs=tolerance)
     # Times within 1 and 2 mm: the poses whose two distances fall on either side of a threshold are within the tolerance of it.

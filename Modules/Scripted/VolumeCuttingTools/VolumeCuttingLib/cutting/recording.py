@@ -234,7 +234,11 @@ def _check_monitor_readings(readings, poses: int, structures: int, where: str) -
 
 
 class MonitorCompactor:
-    """Keeps the nerve monitor's readings of a stroke that matter: the first, and those that moved (``MONITOR_STEP_MM``) or changed level."""
+    """Keeps the nerve monitor's readings of a stroke that matter.
+
+    The first of each structure, then those that changed level or moved by
+    more than ``MONITOR_STEP_MM`` since the last one kept.
+    """
 
     def __init__(self, step_mm: float = MONITOR_STEP_MM):
         self.step_mm = step_mm

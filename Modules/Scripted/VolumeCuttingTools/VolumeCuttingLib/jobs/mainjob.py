@@ -291,7 +291,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     recorder = recording.SessionRecorder(
         {key: {"name": tool.GetName(), "burr_type": toolconfig.from_tool_node(tool).burr_type,
                "radius_mm": toolconfig.from_tool_node(tool).diameter / 2.0} for key, tool in tools.items()},
-        scan=scan_descriptor(volume, use_phantom, seed, own_data, cut_node), description=f"The main job's mastoidectomy on the {description}")
+        scan=scan_descriptor(volume, use_phantom, seed, own_data, cut_node),
+        description=f"The main job's mastoidectomy on the {description}")
     camera = view.renderer.GetActiveCamera()
     recorder.camera(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle())
     with timer.measure("drilling_s"):
