@@ -107,6 +107,57 @@ def test_distances_and_times_near_the_nerve(scene):
     assert m[f"final.removed_mm3.{metrics.band_name('Nerve', (0.0, 1.0))}"] == 0.0
 
 
+def test_recorded_nerve_monitor_readings_are_used_where_present(scene):
+    # The same approach as above (recomputed distances 4.4 3.4 2.4 1.7 1.3 0.6 mm), with monitor readings kept as a
+    # recorder keeps them: at pose 0, then when they moved by more than the step. Said by hand: the monitor reads
+    # 2.2 mm at pose 1 (held at pose 2), 0.9 mm from pose 3 on (held at pose 4), 0.4 mm at pose 5. Pose 0 reads 6.4 mm:
+    # with an 8 mm range and a 1.5 mm burr, readings from 8 - 1.5 - 0.25 = 6.25 mm on are lower bounds, so pose 0
+    # keeps its recomputed 4.4 mm. A structure of the monitor that the scan does not know is ignored.
+    heights = [8.0, 9.0, 10.0, 10.7, 11.1, 11.8]
+    recomputed = np.array([13.9 - 1.5 - z for z in heights])
+    recording = session(scene, [("burr", [[10.0, 10.0, z] for z in heights])], speed=1.0)
+    recording["monitor"] = recordings.monitor_header(None, ["nerve", "Elsewhere"])
+    recording["monitor"]["range_mm"] = 8.0
+    recording["strokes"][0]["monitor"] = [[0, 0, 6.4, 0], [0, 1, 3.0, 1], [1, 0, 2.2, 1], [3, 0, 0.9, 3], [5, 0, 0.4, 3],
+                                          [5, 1, 0.1, 3]]
+    recording["sha256"] = recordings.content_sha256(recording)
+    recordings.check(recording)
+    graded = metrics.assess(recording, scene)
+    m = graded.metrics
+    distances = graded.trainee.distances["Nerve"]
+    assert distances[0] == pytest.approx(recomputed[0], abs=HALF_VOXEL)
+    assert distances[1:].tolist() == [2.2, 2.2, 0.9, 0.9, 0.4]
+    assert m["safety.min_distance_mm.Nerve"] == 0.4 and m["safety.min_distance_mm"] == 0.4
+    # Intervals 0, 1, 1, 0.7, 0.4, 0.7 s: within 2 mm are poses 3-5 (pose 1-2 read 2.2), within 1 mm the same.
+    assert m["safety.time_within_2mm_s.Nerve"] == pytest.approx(0.7 + 0.4 + 0.7)
+    assert m["safety.time_within_1mm_s.Nerve"] == pytest.approx(0.7 + 0.4 + 0.7)
+    assert m["safety.monitor_poses.Nerve"] == 5
+    held = np.array([2.2, 2.2, 0.9, 0.9, 0.4])
+    assert m["safety.monitor_minus_poses_max_abs_mm.Nerve"] == pytest.approx(np.abs(held - recomputed[1:]).max(), abs=HALF_VOXEL)
+    # Not ready at pose 4 (a null distance, level -1): that pose falls back on the recomputed distance.
+    recording["strokes"][0]["monitor"].insert(4, [4, 0, None, -1])
+    recording["sha256"] = recordings.content_sha256(recording)
+    fallback = metrics.assess(recording, scene).trainee.distances["Nerve"]
+    assert fallback[4] == pytest.approx(recomputed[4], abs=HALF_VOXEL) and fallback[3] == 0.9
+    # A reading of a structure the monitor does not list, of a pose the stroke does not have, of no level, is refused.
+    for bad in ([9, 0, 1.0, 1], [0, 2, 1.0, 1], [0, 0, 1.0, 7], [0, 0, None, 2]):
+        broken = json.loads(json.dumps(recording))
+        broken["strokes"][0]["monitor"].append(bad)
+        broken.pop("sha256")
+        with pytest.raises(recordings.RecordingError, match="monitor reading"):
+            recordings.check(broken, require_checksum=False)
+
+
+def test_monitor_readings_are_kept_when_they_change(scene):
+    # A compactor keeps the first reading of a stroke, a level change, and a distance that moved by more than the step.
+    compactor = recordings.MonitorCompactor(step_mm=0.05)
+    readings = [(0, 3.0, 1), (1, 2.98, 1), (2, 2.96, 1), (3, 2.94, 1), (4, 1.9, 2), (5, None, -1), (6, 1.9, 2)]
+    kept = [compactor.keep(pose, 0, distance, level) for pose, distance, level in readings]
+    assert [k[0] for k in kept if k] == [0, 3, 4, 5, 6]
+    compactor.restart()
+    assert compactor.keep(7, 0, 1.9, 2) == [7, 0, 1.9, 2]
+
+
 def test_the_largest_force_near_the_nerve(scene):
     # The same approach with a force per pose (N), falling as the burr nears: within 2 mm are the last three poses.
     heights = [8.0, 9.0, 10.0, 10.7, 11.1, 11.8]
@@ -143,6 +194,31 @@ def test_a_haptic_session_tick_by_tick(scene):
     maybe = drilling & (distance < 2.0 + HALF_VOXEL)
     magnitudes = np.linalg.norm(forces, axis=1)
     assert magnitudes[near].max() <= m["safety.max_force_within_2mm_n.Nerve"] <= magnitudes[maybe].max()
+
+
+def test_a_haptic_session_keeps_the_monitor_readings_that_changed(scene):
+    # 200 ticks at 1 kHz, the drill on throughout, the burr rising 0.01 mm a tick from z = 9 mm: the monitor's
+    # distance (taken here as the analytic one, 13.9 - 1.5 - z) falls 0.01 mm a tick, so with a 0.05 mm step one tick
+    # in six is kept (the first, then each that moved by more than 0.05 mm), plus the level changes at 2 and 1 mm.
+    rate = 1000.0
+    heights = 9.0 + 0.01 * np.arange(200)
+    proxies = np.stack([np.full(200, 10.0), np.full(200, 10.0), heights], axis=1)
+    distances = (13.9 - 1.5 - heights)[:, None]
+    levels = np.digitize(-distances, [-4.0, -2.0, -1.0, 0.0])  # 0 silent .. 4 contact, as the monitor's thresholds
+    header = dict(recordings.monitor_header(None, ["Nerve"]), range_mm=8.0, distances=distances, levels=levels)
+    recording = recordings.from_haptic_ticks(proxies, np.ones(200), np.ones(200, bool), rate, "burr",
+                                             {"burr_type": "Diamond", "radius_mm": 1.5}, np.eye(3), scan=scene.descriptor(),
+                                             monitor=header)
+    recording["sha256"] = recordings.content_sha256(recording)
+    recordings.check(recording)
+    kept = recording["strokes"][0]["monitor"]
+    assert "distances" not in recording["monitor"] and recording["monitor"]["structures"] == ["Nerve"]
+    assert len(kept) == pytest.approx(200 / 6, abs=4) and kept[0] == [0, 0, 3.4, 1]
+    # Held between kept ticks, the readings stay within the step of every tick's own reading.
+    graded = metrics.assess(recording, scene)
+    assert np.abs(graded.trainee.distances["Nerve"] - distances[:, 0]).max() <= recordings.MONITOR_STEP_MM + 1e-9
+    within = graded.metrics["safety.time_within_1mm_s.Nerve"]
+    assert within == pytest.approx(float(np.sum(distances[1:, 0] < 1.0)) / rate, abs=6 / rate)
 
 
 def test_bands_hold_the_removed_bone_at_their_distances(scene):

@@ -55,8 +55,23 @@ def _drive_the_page(browser, server, folder: Path, shots: Path) -> dict:
         app.wait_still(800, 60)
         return app.page.evaluate("() => window.trame.state.get('vc_undo_count')")
 
+    def frames_and_cameras():
+        """The 3D view's frames drawn so far (the server's own log) and the cameras recorded."""
+        answer = app.server_timing()
+        return len(answer["frames"]), answer["camera_frames_recorded"]
+
+    before = frames_and_cameras()
     drilled(0.45)
+    after = frames_and_cameras()
     first = app.total_removed()
+    # A camera drag in navigate mode: every frame drawn while the view turns is recorded with its camera.
+    app.set_mode("navigate")
+    app.drag([_view_point(app, 0.30 + 0.01 * i, 0.50) for i in range(20)], 30)
+    app.wait_still(800, 60)
+    turned = frames_and_cameras()
+    app.set_mode("drill")
+    shown_frames = {"drill_frames": after[0] - before[0], "drill_cameras": after[1] - before[1],
+                    "drag_frames": turned[0] - after[0], "drag_cameras": turned[1] - after[1]}
     steps = drilled(0.56)
     both = app.total_removed()
     assert both > first + 1.0
@@ -79,6 +94,7 @@ def _drive_the_page(browser, server, folder: Path, shots: Path) -> dict:
         "total": total,
         "cortex": app.removed_volume("MastoidCortex"),
     }
+    shown.update(shown_frames)
     shown["recording"] = app.download("report-download-recording", folder)
     app.testid("report-save").click()
     app.wait_for("() => !!window.trame.state.get('vc_rp_saved')", 60, "the records to answer")
@@ -96,13 +112,22 @@ def test_a_web_session_is_recorded_graded_downloaded_and_replayed_bit_for_bit(br
     with AppServer("--phantom", "--records", str(records), log_path=tmp_path / "server.log") as server:
         shown = _drive_the_page(browser, server, tmp_path, shots)
 
+    # Every frame the 3D view drew is recorded with its camera: while drilling and while the camera turned.
+    print(f"frames drawn / cameras recorded: drilling {shown['drill_frames']} / {shown['drill_cameras']}, "
+          f"camera drag {shown['drag_frames']} / {shown['drag_cameras']}")
+    assert shown["drag_frames"] >= 3 and shown["drag_cameras"] == shown["drag_frames"]
+    assert shown["drill_frames"] >= 3 and shown["drill_cameras"] == shown["drill_frames"]
+
     # The file: checked by its sha256, complete.
     recording = recordings.load(shown["recording"])
     strokes = recording["strokes"]
     assert len(strokes) >= 2 and all(len(s["positions"]) == len(s["times"]) > 1 for s in strokes)
     assert f"{len(strokes)} strokes so far" in shown["strokes_text"]
     assert [e["type"] for e in recording["events"] if e["type"] in ("undo", "redo")] == ["undo"]
-    assert len(recording["camera"]["frames"]) >= 2 and recording["scan"]["name"] == "phantom"
+    assert len(recording["camera"]["frames"]) >= shown["drill_cameras"] + shown["drag_cameras"]
+    assert recording["scan"]["name"] == "phantom"
+    # The phantom's protected structures are monitored: the strokes carry the monitor's readings.
+    assert recording["monitor"]["structures"] and all(s.get("monitor") for s in strokes)
     assert {s["tool"] for s in strokes} <= set(recording["tools"])
 
     # The page's grade is the assessment of the downloaded recording.
@@ -189,4 +214,40 @@ def test_the_recording_of_strokes_tool_changes_and_undo_replays_to_the_same_cut(
     live.load("phantom")
     assert recording.stroke_count == 0
     other.close()
+    live.close()
+
+
+def test_a_web_session_on_an_own_scan_is_graded_on_the_users_segments(tmp_path):
+    """The user's CT and labelmap loaded in the page's session, roles set as the segments table sets them: the
+    recording names the scan by its files and roles, and the Report panel's grading takes its regions and
+    structures at risk from the user's segments, the nerve monitor's readings with the poses."""
+    from trame_slicer.core import SlicerApp
+
+    from test_assessment_owndata import BURR_RADIUS, CLOSEST_MM, STROKE, own_case
+    from VolumeCuttingLib.webapp.session import tool_pose
+
+    slicer_app = SlicerApp()
+    logic = slicer_app.register_module_logic(slicer.vtkSlicerVolumeCuttingLogic(), logic_name="VolumeCutting")
+    ct_path, labels_path = own_case(tmp_path)
+    live = DrillSession(slicer_app.scene, logic, tmp_path / "live")
+    live.load("own", ct_path=ct_path, segmentation_path=labels_path)
+    recording = sessionrecording.WebSessionRecording(live)
+    segmentation = live.segmentation.GetSegmentation()
+    by_name = {segmentation.GetSegment(s).GetName(): s for s in segmentation.GetSegmentIDs()}
+    live.set_role(by_name["Temporal bone"], "cuttable")
+    live.set_role(by_name["Facial nerve"], "protected")
+    live.set_tool(shape="Sphere", burr_type="Cutting", diameter=2.0 * BURR_RADIUS)
+    logic.WaitForNerveMonitor(live.cut_node)
+    assert live.begin_stroke()
+    for position in STROKE:  # the burr's centre along -x, as in the main job's test
+        live.move_tool(tool_pose(position, (-1.0, 0.0, 0.0), live.tool_reach(), live.tool_reach()))
+    live.end_stroke()
+    snapshot = recording.snapshot("Ann Resident")
+    assert snapshot["scan"]["name"] == "own" and snapshot["scan"]["parameters"]["protected"] == ["Facial nerve"]
+    assert snapshot["monitor"]["structures"] == ["Facial nerve"] and snapshot["strokes"][0]["monitor"]
+    graded = sessionrecording.grade(snapshot)
+    m = graded.metrics
+    assert graded.reference is None and m["final.removed_mm3.Temporal bone"] > 10.0
+    assert m["safety.min_distance_mm.Facial nerve"] == pytest.approx(CLOSEST_MM, abs=0.1)
+    assert m["safety.monitor_poses.Facial nerve"] > 0
     live.close()

@@ -14,7 +14,13 @@ the side of the burr facing it crosses an opaque voxel of the operative field
 Distances are from the burr's surface to a structure's surface: the distance
 from the burr centre to the nearest surface-voxel centre of the structure,
 less half a voxel (where the voxelised surface lies) and the burr radius;
-negative inside. Each pose stands for the interval since the previous pose
+negative inside. Where the recording holds the nerve monitor's readings
+(version 3), a structure's distance at a pose is the monitor's (the last
+reading kept at or before the pose in its stroke, within the recording's
+step of the live value; the monitor measures to the smoothed surface the
+view draws), and the recomputed one where the monitor did not read (not
+ready, or beyond its range, where its reading is only a lower bound); the
+JSON says how many poses each came from and how far the two differ. Each pose stands for the interval since the previous pose
 of its stroke (the first of a stroke for none): times within 1 and 2 mm,
 the largest force there (where a device recorded forces),
 contact time and hidden time add those intervals up; idle time is the
@@ -50,6 +56,9 @@ LARGE_BURR_TIME_SCALE_S = 2.0  # exp(-time of a large cutting burr within 2 mm /
 # Version 1 recordings have no times: their burr is taken to move at this speed, pausing between strokes.
 UNTIMED_SPEED_MM_S = 5.0
 UNTIMED_PAUSE_S = 0.5
+# Readings this close below the nerve monitor's exact limit (range less the burr's radius) interpolate towards
+# the plateau beyond it: they count as lower bounds too.
+MONITOR_RANGE_MARGIN_MM = 0.25
 
 
 class AssessmentError(ValueError):
@@ -78,6 +87,8 @@ class Replay:
     final_removed: np.ndarray  # bool, crop shaped
     forces: np.ndarray | None = None  # (N,) force on the tool, N, where recorded (NaN elsewhere); None: none recorded
     distances: dict = field(default_factory=dict)  # structure -> (N,) burr surface to structure surface, mm
+    recomputed: dict = field(default_factory=dict)  # structure -> (N,) the distance recomputed from the poses, mm
+    monitored: dict = field(default_factory=dict)  # structure -> (N,) the nerve monitor's recorded distance, NaN where none
     undo: int = 0
     redo: int = 0
 
@@ -289,7 +300,49 @@ def replay(recording: dict, crop: Crop) -> Replay:
     forces = [np.asarray(stroke["forces"], dtype=float) if "forces" in stroke else np.full(len(stroke["positions"]), np.nan)
               for stroke in recording["strokes"]]
     result.forces = np.concatenate(forces) if any("forces" in stroke for stroke in recording["strokes"]) else None
-    result.distances = {structure: structure_distances(scan, structure, positions) - radii for structure in scan.protected}
+    result.recomputed = {structure: structure_distances(scan, structure, positions) - radii for structure in scan.protected}
+    result.monitored = monitor_distances(recording, scan.protected, radii)
+    result.distances = {structure: np.where(np.isfinite(result.monitored[structure]), result.monitored[structure], recomputed)
+                        if structure in result.monitored else recomputed for structure, recomputed in result.recomputed.items()}
+    return result
+
+
+def _name_key(name: str) -> str:
+    return " ".join(str(name).replace("_", " ").lower().split())
+
+
+def monitor_distances(recording: dict, structures, radii) -> dict:
+    """Per structure, the nerve monitor's recorded distance at each pose (mm; NaN where it gave none in range).
+
+    Readings are held from the pose they were kept at to the next one of the
+    same structure in the stroke; structures match by name (case, '_' and
+    spaces aside). The monitor stores a structure's field only within its
+    range of the surface, so a burr of radius r reads exactly below range - r
+    (``radii``: per pose); readings from there on are lower bounds (a plateau
+    at range - r) and count as none.
+    """
+    header = recording.get("monitor")
+    if not header:
+        return {}
+    total = sum(len(stroke["positions"]) for stroke in recording["strokes"])
+    result = {structure: np.full(total, np.nan) for structure in structures}
+    by_key = {_name_key(structure): structure for structure in structures}
+    columns = [by_key.get(_name_key(name)) for name in header["structures"]]
+    limits = float(header.get("range_mm", np.inf)) - np.asarray(radii, dtype=float) - MONITOR_RANGE_MARGIN_MM
+    offset = 0
+    for stroke in recording["strokes"]:
+        count = len(stroke["positions"])
+        readings = sorted(stroke.get("monitor", []), key=lambda reading: reading[0])
+        for index, structure in enumerate(columns):
+            if structure is None:
+                continue
+            mine = [reading for reading in readings if reading[1] == index]
+            for n, (pose, _, distance, _level) in enumerate(mine):
+                stop = mine[n + 1][0] if n + 1 < len(mine) else count
+                span = slice(offset + pose, offset + stop)
+                held = np.full(stop - pose, np.nan if distance is None else float(distance))
+                result[structure][span] = np.where(held < limits[span], held, np.nan)
+        offset += count
     return result
 
 
@@ -369,6 +422,13 @@ def _safety(scan, replayed: Replay, recording: dict, metrics: dict) -> float:
         minimum = float(distance[drilling].min()) if drilling.any() else float("inf")
         overall_min = min(overall_min, minimum)
         metrics[f"safety.contacts.{structure}"] = contacts
+        if structure in replayed.monitored:
+            monitored = np.isfinite(replayed.monitored[structure]) & drilling
+            # How the recorded readings agree with the distances recomputed from the poses.
+            metrics[f"safety.monitor_poses.{structure}"] = int(monitored.sum())
+            difference = replayed.monitored[structure][monitored] - replayed.recomputed[structure][monitored]
+            metrics[f"safety.monitor_minus_poses_max_abs_mm.{structure}"] = float(np.abs(difference).max()) if len(difference) else 0.0
+            metrics[f"safety.monitor_minus_poses_mean_mm.{structure}"] = float(difference.mean()) if len(difference) else 0.0
         metrics[f"safety.contact_time_s.{structure}"] = float(intervals[touching].sum())
         metrics[f"safety.min_distance_mm.{structure}"] = minimum
         for near in NEAR_MM:

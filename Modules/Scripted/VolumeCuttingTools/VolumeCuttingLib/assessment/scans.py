@@ -14,16 +14,24 @@ product's bone segmentation does (cortical from 700 HU, trabecular from
 right mastoid's lateral surface, deeper than the shipped mastoidectomy goes:
 a 3 mm facial canal about 4 mm beyond the saucer's floor and an 8 mm sigmoid
 sinus posterior to it (the CT's voxels are about 1 x 1 x 1.5 mm). They are stand-ins for grading, not the patient's anatomy.
+
+A user's own scan (``own_scan``) is their segmentation on their CT's grid,
+the roles by the names they gave (``owndata.resolve_roles``): its descriptor
+names the files, the roles and the segmentation file's sha256, and
+``from_descriptor`` reads them again through Slicer's readers (MRML, no Qt),
+refusing a segmentation file that changed since the session.
 """
 
 from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from ..data import headct, phantom
+from ..data import headct, owndata, phantom
+from ..scene import nodes
 
 
 class ScanError(ValueError):
@@ -240,6 +248,112 @@ def analytic_scan(dimensions=(40, 40, 40), spacing=0.5, bone_box=((2.0, 2.0, 2.0
     return Scan("analytic", parameters, labels.reshape(dims[::-1]), ["Bone", "Nerve"], ("Bone",), ("Nerve",), ("Bone", "Nerve"), matrix)
 
 
+# ---------------------------------------------------------------------------
+# The user's own scan
+# ---------------------------------------------------------------------------
+
+OWN = "own"
+
+
+def file_sha256(path) -> str:
+    import hashlib
+
+    digest = hashlib.sha256()
+    with open(path, "rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def _segment_mask(segment, ct_to_ras: np.ndarray, shape) -> np.ndarray:
+    """The segment's voxels on the CT's grid (``[k, j, i]``); its labelmap lies on the CT's lattice (``owndata``)."""
+    import slicer
+    import vtk
+
+    mask = np.zeros(shape, dtype=bool)
+    image = segment.GetRepresentation(slicer.vtkSegmentationConverter.GetBinaryLabelmapRepresentationName())
+    if image is None:
+        return mask
+    extent = image.GetExtent()
+    if extent[1] < extent[0] or extent[3] < extent[2] or extent[5] < extent[4]:
+        return mask
+    matrix = vtk.vtkMatrix4x4()
+    image.GetImageToWorldMatrix(matrix)
+    to_ct = np.linalg.inv(ct_to_ras) @ nodes.vtk_matrix_to_numpy(matrix)
+    offset = np.rint(to_ct[:3, 3]).astype(int)
+    if not np.allclose(to_ct[:3, :3], np.eye(3), atol=1e-3) or not np.allclose(to_ct[:3, 3], offset, atol=1e-3):
+        raise ScanError(f"segment '{segment.GetName()}' is not on the CT's voxel grid")
+    values = nodes.array_from_image_data(image) == segment.GetLabelValue()
+    low = np.array(extent[0::2]) + offset  # i, j, k of the image's first voxel on the CT
+    high = low + np.array(values.shape[::-1])
+    clipped_low, clipped_high = np.maximum(low, 0), np.minimum(high, np.array(shape[::-1]))
+    if np.any(clipped_high <= clipped_low):
+        return mask
+    source = values[tuple(slice(a - l, b - l) for a, b, l in zip(clipped_low[::-1], clipped_high[::-1], low[::-1]))]
+    mask[tuple(slice(a, b) for a, b in zip(clipped_low[::-1], clipped_high[::-1]))] = source
+    return mask
+
+
+def own_scan(volume_node, segmentation_node, cuttable_ids, protected_ids, parameters: dict | None = None) -> Scan:
+    """The user's scan as the assessment grades it: their segments on the CT's grid, with the roles given.
+
+    Segments are named as the product shows them (``segment_display_names``).
+    Where segments overlap a voxel is the protected one's, else the cuttable
+    one's. Cuttable and protected segments hide the burr from the camera.
+    """
+    segmentation = segmentation_node.GetSegmentation()
+    ids = list(segmentation.GetSegmentIDs())
+    names = nodes.segment_display_names(segmentation, ids)
+    ct_to_ras = nodes.volume_node_ijk_to_ras(volume_node)
+    shape = tuple(volume_node.GetImageData().GetDimensions())[::-1]
+    labels = np.zeros(shape, dtype=np.uint16 if len(ids) >= 255 else np.uint8)
+    ranked = [s for s in ids if s not in cuttable_ids and s not in protected_ids] + list(cuttable_ids) + list(protected_ids)
+    for segment_id in ranked:
+        labels[_segment_mask(segmentation.GetSegment(segment_id), ct_to_ras, shape)] = ids.index(segment_id) + 1
+    cuttable = tuple(names[s] for s in cuttable_ids)
+    protected = tuple(names[s] for s in protected_ids)
+    return Scan(OWN, dict(parameters or {}), labels, [names[s] for s in ids], cuttable, protected, cuttable + protected, ct_to_ras)
+
+
+def own_descriptor(volume_node, segmentation_node, cuttable_ids, protected_ids, ct, segmentation, color_table=None) -> dict:
+    """What a recording on the user's scan says of it: the files, the roles by name, the segmentation's sha256, the grid."""
+    names = nodes.segment_display_names(segmentation_node.GetSegmentation(), segmentation_node.GetSegmentation().GetSegmentIDs())
+    ct_to_ras = nodes.volume_node_ijk_to_ras(volume_node)
+    return {"name": OWN, "parameters": {
+        "ct": str(Path(ct).resolve()), "segmentation": str(Path(segmentation).resolve()),
+        "color_table": str(Path(color_table).resolve()) if color_table else None,
+        "segmentation_sha256": file_sha256(segmentation),
+        "cuttable": [names[s] for s in cuttable_ids], "protected": [names[s] for s in protected_ids]},
+        "grid": {"dimensions": list(volume_node.GetImageData().GetDimensions()),
+                 "ijk_to_ras": [round(float(v), 6) for v in ct_to_ras.ravel()]}}
+
+
+def _own_from_files(parameters: dict) -> Scan:
+    """Read the user's CT and segmentation again (a fresh MRML scene) and build their scan."""
+    import slicer
+
+    needed = [key for key in ("ct", "segmentation", "cuttable", "protected") if key not in parameters]
+    if needed:
+        raise ScanError(f"the recording's own scan does not say its {', '.join(needed)}")
+    segmentation_path = Path(parameters["segmentation"])
+    if not segmentation_path.is_file():
+        raise ScanError(f"the recording's segmentation {segmentation_path} is no longer there: the session cannot be graded "
+                        "without the segmentation it was drilled on")
+    if parameters.get("segmentation_sha256") and file_sha256(segmentation_path) != parameters["segmentation_sha256"]:
+        raise ScanError(f"the segmentation {segmentation_path} changed since the session (its sha256 differs from the one "
+                        "the recording keeps): grade it on the segmentation it was drilled on")
+    scene = slicer.vtkMRMLScene()
+    try:
+        volume = owndata.load_ct(scene, parameters["ct"], choose_series=True)
+        segmentation = owndata.load_segmentation(scene, segmentation_path, volume, color_table=parameters.get("color_table"))
+        cuttable, protected = owndata.resolve_roles(segmentation, parameters["cuttable"], parameters["protected"])
+        return own_scan(volume, segmentation, cuttable, protected, parameters)
+    except owndata.InputError as error:
+        raise ScanError(f"the recording's own scan cannot be read again: {error}") from None
+    finally:
+        scene.Clear(True)
+
+
 def from_descriptor(descriptor: dict | None) -> Scan:
     """Rebuild the scan a recording names; ScanError when it names none or one that cannot be rebuilt here."""
     if not descriptor:
@@ -251,8 +365,10 @@ def from_descriptor(descriptor: dict | None) -> Scan:
         scan = head_ct_scan()
     elif name == "analytic":
         scan = analytic_scan(**parameters)
+    elif name == OWN:
+        scan = _own_from_files(parameters)
     else:
-        raise ScanError(f"the recording's scan '{name}' cannot be rebuilt here (known: phantom, headct, analytic)")
+        raise ScanError(f"the recording's scan '{name}' cannot be rebuilt here (known: phantom, headct, analytic, own)")
     check_fits(scan, descriptor, "the recording")
     return scan
 

@@ -16,7 +16,11 @@ camera of every rendered frame (what the trainee could see), events (drill
 on/off, tool changes, undo/redo, contacts), the force on the tool per pose
 where a haptic device measured one, and the removed volume per segment over
 time; and a sha256 of its content, checked on reading, so a truncated or
-edited file is refused rather than graded. Version 1 files are still read.
+edited file is refused rather than graded. Version 3 adds the virtual nerve
+monitor's readings (``MONITOR_FIELDS``): per stroke, for each monitored
+structure, its distance (mm) and level at the poses where the reading
+changed (the level, or the distance by more than ``MONITOR_STEP_MM``), and
+at each stroke's first pose. Versions 1 and 2 are still read.
 
     python -m VolumeCuttingLib.cutting.recording --head-ct OUT.json   # record the shipped mastoidectomy
 """
@@ -36,10 +40,20 @@ import numpy as np
 from ..scene.resources import find_resource
 
 FORMAT = "VolumeCuttingRecording"
-VERSION = 2
-READABLE_VERSIONS = (1, 2)
+VERSION = 3
+READABLE_VERSIONS = (1, 2, 3)
 EVENT_TYPES = ("drill_on", "drill_off", "tool_change", "undo", "redo", "contact")
 CAMERA_FIELDS = ("t", "position", "focal_point", "view_up", "view_angle")
+# A nerve-monitor reading: the pose of its stroke it was taken at, the
+# structure (an index into the recording's monitor structures), the distance
+# from the tool's surface to the structure's surface (mm, None while not
+# ready) and the level (vtkVolumeCutNerveMonitor: 0 silent .. 4 contact, -1 not ready).
+MONITOR_FIELDS = ("pose", "structure", "distance_mm", "level")
+# A reading is kept when it moved by more than this since the last one kept:
+# at 1 kHz most ticks change the distance by microns, and the metrics
+# (1 and 2 mm bands, the minimum) need no finer step.
+MONITOR_STEP_MM = 0.05
+MONITOR_LEVELS = range(-1, 5)
 HEAD_CT_MASTOIDECTOMY = "HeadCTMastoidectomy.json"
 
 
@@ -192,14 +206,78 @@ def check(recording, path="recording", require_checksum=True) -> None:
             previous_time = times[-1]
             if "forces" in stroke and not _finite_list(stroke["forces"], len(positions)):
                 raise RecordingError(f"{where}: 'forces' must be one finite force (N) per position")
+            if "monitor" in stroke:
+                _check_monitor_readings(stroke["monitor"], len(positions), len(recording.get("monitor", {}).get("structures", [])), where)
     if version >= 2:
         for index, event in enumerate(recording.get("events", [])):
             if not isinstance(event, dict) or event.get("type") not in EVENT_TYPES or not _finite_list([event.get("t")], 1):
                 raise RecordingError(f"{path}: event {index} needs a time 't' and a type among {', '.join(EVENT_TYPES)}")
+        monitor = recording.get("monitor")
+        if monitor is not None and (not isinstance(monitor, dict) or not isinstance(monitor.get("structures"), list)
+                                    or not all(isinstance(name, str) for name in monitor["structures"])):
+            raise RecordingError(f"{path}: 'monitor' must name its structures (a list of segment names)")
         frames = recording.get("camera", {}).get("frames", [])
         for index, frame in enumerate(frames):
             if not _finite_list(frame, 11):
                 raise RecordingError(f"{path}: camera frame {index} must be 11 numbers: t, position, focal point, view up, view angle")
+
+
+def _check_monitor_readings(readings, poses: int, structures: int, where: str) -> None:
+    if not isinstance(readings, list):
+        raise RecordingError(f"{where}: 'monitor' must be a list of readings [{', '.join(MONITOR_FIELDS)}]")
+    for reading in readings:
+        if not isinstance(reading, list) or len(reading) != 4 or not all(isinstance(v, int) for v in (reading[0], reading[1], reading[3])) \
+                or not 0 <= reading[0] < poses or not 0 <= reading[1] < structures or reading[3] not in MONITOR_LEVELS \
+                or not (reading[2] is None if reading[3] == -1 else _finite_list([reading[2]], 1)):
+            raise RecordingError(f"{where}: monitor reading {reading!r} is not [pose of the stroke, structure index, "
+                                 f"distance mm (null when not ready), level -1..4]")
+
+
+class MonitorCompactor:
+    """Keeps the nerve monitor's readings of a stroke that matter.
+
+    The first of each structure, then those that changed level or moved by
+    more than ``MONITOR_STEP_MM`` since the last one kept.
+    """
+
+    def __init__(self, step_mm: float = MONITOR_STEP_MM):
+        self.step_mm = step_mm
+        self._last = {}
+
+    def restart(self) -> None:
+        """A new stroke: its first readings are all kept, so that a stroke reads on its own."""
+        self._last = {}
+
+    def keep(self, pose: int, structure: int, distance, level: int):
+        """The reading as recorded ``[pose, structure, distance, level]`` when it is kept, else None."""
+        distance = None if distance is None or not np.isfinite(distance) or level < 0 else round(float(distance), 4)
+        level = -1 if distance is None else int(level)
+        last = self._last.get(structure)
+        if last is not None and last[1] == level and (distance is None or abs(distance - last[0]) <= self.step_mm):
+            return None
+        self._last[structure] = (distance, level)
+        return [int(pose), int(structure), distance, level]
+
+
+def monitor_readings(monitor) -> list:
+    """The readings of a ``vtkVolumeCutNerveMonitor`` now: (structure name, distance mm or None, level) per structure."""
+    if monitor is None:
+        return []
+    result = []
+    for index in range(monitor.GetNumberOfStructures()):
+        distance = monitor.GetDistance(index)
+        level = int(monitor.GetLevel(index))
+        result.append((monitor.GetStructureName(index), None if level < 0 or not np.isfinite(distance) else float(distance), level))
+    return result
+
+
+def monitor_header(monitor, structures) -> dict:
+    """What a recording says of its monitor: the structures' names, the thresholds, the range and the step readings are kept at."""
+    header = {"structures": list(structures), "fields": list(MONITOR_FIELDS), "step_mm": MONITOR_STEP_MM}
+    if monitor is not None:
+        header.update(range_mm=float(monitor.GetRange()), thresholds_mm=[float(monitor.GetSilentThreshold()),
+                      float(monitor.GetSparseThreshold()), float(monitor.GetBurstThreshold())])
+    return header
 
 
 def tool_of(recording: dict, key: str) -> dict:
@@ -249,13 +327,17 @@ def timed(recording: dict, tools: dict, speed_mm_s: float = 5.0, pause_s: float 
 
 
 def from_haptic_ticks(proxies, forces, drilling, rate_hz: float, tool_key: str, tool: dict, rotation,
-                      scan: dict | None = None, description: str = "", started: str | None = None) -> dict:
-    """A version 2 recording of a haptic session, tick by tick (``vtkHapticRecorder``: proxy, force, drilling).
+                      scan: dict | None = None, description: str = "", started: str | None = None,
+                      monitor: dict | None = None) -> dict:
+    """A recording of a haptic session, tick by tick (``vtkHapticRecorder``: proxy, force, drilling).
 
     Each run of ticks with the drill on is a stroke at the device's rate:
     positions are the proxy's (where the tool is held on the bone, RAS mm),
     times the tick index over ``rate_hz``, forces the magnitude of the force
     sent (N). Ticks with the drill off move no stroke; their time is idle.
+    ``monitor``: the nerve monitor's readings per tick, ``monitor_header``'s
+    dict with ``distances`` and ``levels`` (ticks x structures) added; kept
+    as a live session keeps them (``MonitorCompactor``).
     """
     proxies = np.asarray(proxies, dtype=float).reshape(-1, 3)
     forces = np.asarray(forces, dtype=float)
@@ -268,27 +350,40 @@ def from_haptic_ticks(proxies, forces, drilling, rate_hz: float, tool_key: str, 
     edges = np.flatnonzero(np.diff(np.concatenate([[0], drilling.astype(np.int8), [0]])))
     strokes, events = [], [{"t": 0.0, "type": "tool_change", "tool": tool_key}]
     rotation = [float(v) for v in np.asarray(rotation, dtype=float).ravel()]
+    if monitor is not None:
+        distances = np.asarray(monitor["distances"], dtype=float).reshape(len(proxies), -1)
+        levels = np.asarray(monitor["levels"], dtype=int).reshape(len(proxies), -1)
+        compactor = MonitorCompactor(monitor.get("step_mm", MONITOR_STEP_MM))
     for first, stop in zip(edges[0::2], edges[1::2]):
         times = np.arange(first, stop) / rate_hz
         events += [{"t": float(times[0]), "type": "drill_on"}, {"t": float(times[-1]), "type": "drill_off"}]
         strokes.append({"tool": tool_key, "action": "cut", "rotation": rotation, "positions": proxies[first:stop].tolist(),
                         "times": times.tolist(), "forces": forces[first:stop].tolist()})
+        if monitor is not None:
+            compactor.restart()
+            kept = (compactor.keep(tick - first, index, distances[tick, index], levels[tick, index])
+                    for tick in range(first, stop) for index in range(distances.shape[1]))
+            strokes[-1]["monitor"] = [reading for reading in kept if reading is not None]
     recording = {"format": FORMAT, "version": VERSION, "description": description, "frame": "RAS", "units": "mm",
                  "started": started or datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
                  "trainee": None, "tools": {tool_key: tool}, "strokes": strokes, "events": events}
+    if monitor is not None:
+        recording["monitor"] = {key: value for key, value in monitor.items() if key not in ("distances", "levels")}
     if scan is not None:
         recording["scan"] = scan
     return recording
 
 
 class SessionRecorder:
-    """Records a live session as a version 2 recording: strokes with a time per pose, events, camera frames, removed volumes.
+    """Records a live session as a recording: strokes with a time per pose, events, camera frames, removed volumes.
 
     The application calls it where it drives the logic (``replay`` does, when
     given one): ``begin_stroke`` / ``pose`` / ``end_stroke`` around
     ``MoveActiveTool``, ``event`` for undo, redo and drill switches,
     ``camera`` per rendered frame, ``removed`` after each stroke. Times are
-    seconds since the recorder started, from ``clock``.
+    seconds since the recorder started, from ``clock``. ``pose`` takes the
+    nerve monitor's readings at that pose (``monitor_readings``); the
+    recording keeps those that changed (``MonitorCompactor``).
     """
 
     def __init__(self, tools: dict, scan: dict | None = None, trainee: str | None = None, description: str = "", clock=time.perf_counter):
@@ -304,6 +399,20 @@ class SessionRecorder:
             self.recording["scan"] = scan
         self._stroke = None
         self._tool = None
+        self._compactor = MonitorCompactor()
+
+    def monitor(self, monitor) -> None:
+        """Say which nerve monitor the readings come from (its structures, thresholds and range)."""
+        known = self.recording.get("monitor", {}).get("structures", [])
+        names = known + [monitor.GetStructureName(i) for i in range(monitor.GetNumberOfStructures())
+                         if monitor.GetStructureName(i) not in known]
+        self.recording["monitor"] = monitor_header(monitor, names)
+
+    def _structure_index(self, name: str) -> int:
+        structures = self.recording.setdefault("monitor", monitor_header(None, []))["structures"]
+        if name not in structures:
+            structures.append(name)
+        return structures.index(name)
 
     def now(self) -> float:
         return round(self._clock() - self._origin, 6)
@@ -320,15 +429,22 @@ class SessionRecorder:
         self.event("drill_on")
         self._stroke = {"tool": tool, "action": action, "rotation": [float(v) for v in np.asarray(rotation, dtype=float).ravel()],
                         "positions": [], "times": []}
+        self._compactor.restart()
 
-    def pose(self, position, force_n: float | None = None) -> None:
-        """A pose of the stroke; ``force_n`` the magnitude of the force on the tool (N), where a device measures it."""
+    def pose(self, position, force_n: float | None = None, readings=()) -> None:
+        """A pose of the stroke; ``force_n`` the magnitude of the force on the tool (N), where a device measures it;
+        ``readings`` the nerve monitor's (name, distance mm or None, level) per structure there."""
+        pose = len(self._stroke["positions"])
         self._stroke["positions"].append([float(v) for v in position])
         self._stroke["times"].append(self.now())
         if force_n is not None:
-            self._stroke.setdefault("forces", [0.0] * (len(self._stroke["positions"]) - 1)).append(float(force_n))
+            self._stroke.setdefault("forces", [0.0] * pose).append(float(force_n))
         elif "forces" in self._stroke:
             self._stroke["forces"].append(0.0)
+        for name, distance, level in readings:
+            kept = self._compactor.keep(pose, self._structure_index(name), distance, level)
+            if kept is not None:
+                self._stroke.setdefault("monitor", []).append(kept)
 
     def end_stroke(self) -> None:
         self.event("drill_off")
@@ -384,6 +500,11 @@ def replay(logic, cut_node, recording: dict, tool_nodes: dict, recorder: Session
     refused = 0
     edits = edits_before_strokes(recording)
     contact_table = logic.GetContactTableNode(cut_node) if recorder is not None else None
+    # The nerve monitor's readings go with the poses; its fields are built first, so that every pose reads.
+    monitor = logic.GetNerveMonitor(cut_node) if recorder is not None else None
+    if monitor is not None:
+        logic.WaitForNerveMonitor(cut_node)
+        recorder.monitor(monitor)
     contacts_seen = contact_table.GetNumberOfRows() if contact_table is not None else 0
     segmentation = cut_node.GetSegmentationNode().GetSegmentation() if recorder is not None and cut_node.GetSegmentationNode() else None
 
@@ -422,7 +543,7 @@ def replay(logic, cut_node, recording: dict, tool_nodes: dict, recorder: Session
             times.append(1000.0 * (time.perf_counter() - start))
             refused += not accepted
             if recorder is not None:
-                recorder.pose(position)
+                recorder.pose(position, readings=monitor_readings(monitor))
         logic.EndStroke(cut_node)
         if recorder is not None:
             recorder.end_stroke()

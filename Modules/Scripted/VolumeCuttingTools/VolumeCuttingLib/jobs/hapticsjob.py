@@ -211,6 +211,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     drilling = np.array(drilling, dtype=bool)
     proxies = np.array(proxies)
     nerve_monitor = {"monitored": 0}
+    tick_readings = None
     if monitor is not None:
         # The ticks measured the burr at its proxy: the same fields at the same positions give their readings.
         ticks_recording = nervemonitor.recording_along(monitor, proxies, tool.GetCuttingRadius(), 1.0 / RATE_HZ)
@@ -225,13 +226,20 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
             "display_updates": display_readings.summary()["samples"],
             **ticks_recording.summary(),
         }
+        # The complete recording keeps the readings of every tick that moved or changed level.
+        names = list(ticks_recording.distances_mm)
+        tick_readings = dict(recording.monitor_header(monitor, names),
+                             distances=np.array([ticks_recording.distances_mm[name] for name in names]).T,
+                             levels=np.array([[nervemonitor.LEVEL_NAMES.index(level) if level in nervemonitor.LEVEL_NAMES else -1
+                                               for level in ticks_recording.levels[name]] for name in names]).T)
     # How deep the burr's centre went past the surface it started from.
     deepest = float(np.max((proxies - surface) @ direction)) if len(proxies) else 0.0
     parameters = toolconfig.from_tool_node(tool)
     complete = None if not drilling.any() else recording.save(recording.from_haptic_ticks(
         proxies, magnitudes, drilling, RATE_HZ, "haptic", {"name": tool.GetName(), "burr_type": parameters.burr_type,
                                                             "radius_mm": parameters.diameter / 2.0},
-        rotation, scan=scan, description="The main job's haptic session, tick by tick"), out_dir / "haptic_session.json")
+        rotation, scan=scan, description="The main job's haptic session, tick by tick", monitor=tick_readings),
+        out_dir / "haptic_session.json")
     tool_pose = vtk.vtkMatrix4x4()
     tool.GetParentTransformNode().GetMatrixTransformToWorld(tool_pose)
     return {

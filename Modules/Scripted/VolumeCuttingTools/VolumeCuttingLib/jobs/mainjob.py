@@ -32,6 +32,7 @@ import slicer
 from . import hapticsjob, selftests, softcutjob
 from ..assessment import metrics as assessment_metrics
 from ..assessment import report as assessment_report
+from ..assessment import scans as assessment_scans
 from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
@@ -171,10 +172,18 @@ def removed_region_view(removed_fraction_node):
     return center, field
 
 
-def scan_descriptor(volume, use_phantom: bool, seed: int, own_data: OwnData | None) -> dict:
-    """What a recording says of the scan it was drilled on: the name the assessment rebuilds it by, and its grid."""
+def scan_descriptor(volume, use_phantom: bool, seed: int, own_data: OwnData | None, cut_node=None) -> dict:
+    """What a recording says of the scan it was drilled on: the name the assessment rebuilds it by, and its grid.
+
+    The user's own scan with their segmentation is named by its files and
+    the roles of ``cut_node`` (``assessment.scans.own_descriptor``).
+    """
     ijk_to_ras = volume_node_ijk_to_ras(volume)
     grid = {"dimensions": list(volume.GetImageData().GetDimensions()), "ijk_to_ras": [round(float(v), 6) for v in ijk_to_ras.ravel()]}
+    if own_data is not None and own_data.segmentation is not None and cut_node is not None:
+        return assessment_scans.own_descriptor(volume, cut_node.GetSegmentationNode(), list(cut_node.GetCuttableSegmentIDs()),
+                                               list(cut_node.GetProtectedSegmentIDs()), own_data.ct, own_data.segmentation,
+                                               own_data.color_table)
     if own_data is not None:
         return {"name": "own", "parameters": {"ct": str(own_data.ct)}, "grid": grid}
     if use_phantom:
@@ -282,7 +291,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     recorder = recording.SessionRecorder(
         {key: {"name": tool.GetName(), "burr_type": toolconfig.from_tool_node(tool).burr_type,
                "radius_mm": toolconfig.from_tool_node(tool).diameter / 2.0} for key, tool in tools.items()},
-        scan=scan_descriptor(volume, use_phantom, seed, own_data), description=f"The main job's mastoidectomy on the {description}")
+        scan=scan_descriptor(volume, use_phantom, seed, own_data, cut_node),
+        description=f"The main job's mastoidectomy on the {description}")
     camera = view.renderer.GetActiveCamera()
     recorder.camera(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle())
     with timer.measure("drilling_s"):
@@ -301,7 +311,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     # adds to the recorded mastoidectomy's volume in the tables that follow.
     with timer.measure("haptics_s"):
         haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render,
-                                 scan=scan_descriptor(volume, use_phantom, seed, own_data))
+                                 scan=scan_descriptor(volume, use_phantom, seed, own_data, cut_node))
     removed_per_segment = by_segment_name(roles, {
         segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
         for segment_id in roles.GetSegmentIDs()
@@ -437,8 +447,9 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
         "image_slice_view": str(slice_path),
         "timings": timer.seconds,
     }
-    # The recorded session graded (vc assess): on the shipped scans, which the assessment rebuilds.
-    if own_data is None:
+    # The recorded session graded (vc assess): on the shipped scans, which the assessment rebuilds, and on the
+    # user's scan with their segmentation (read again from their files, the roles by their names).
+    if own_data is None or own_data.segmentation is not None:
         with timer.measure("assessment_s"):
             graded = assessment_metrics.assess(recording.load(session_path), recording_path=session_path)
             written = assessment_report.write(graded, out_dir / "assessment")
@@ -446,7 +457,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
                                  "metrics": str(written["json"])}
     else:
         summary["assessment"] = {"session": str(session_path), "score": None,
-                                 "report": "not graded: the assessment rebuilds only the shipped scans"}
+                                 "report": "not graded: without a segmentation of the user's there are no regions or "
+                                           "structures at risk to grade against (give --segmentation)"}
     # Soft-tissue resection planning (SoftCut) on the head CT, in its own scene.
     summary["softcut"] = softcutjob.run(out_dir, size=size, head_ct=not use_phantom and own_data is None)
     if own_data is not None:

@@ -636,7 +636,7 @@ class VolumeCuttingApp(TrameApp):
             # For tests and benchmarks: what the server did and which mode it is in.
             return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]),
                     "frames": list(self.timing["frames"]), "ready_at": self.timing["ready_at"], "mode": self.drill.mode,
-                    "monitor": self.monitor_meter.diagnostics()}
+                    "monitor": self.monitor_meter.diagnostics(), "camera_frames_recorded": self.recording.camera_frame_count}
 
         @ctrl.trigger("vc_place_tool")
         def place_tool(point):

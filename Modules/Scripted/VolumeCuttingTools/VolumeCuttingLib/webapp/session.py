@@ -160,6 +160,7 @@ class DrillSession:
         self.tool_node = None
         self.description = ""
         self.source = ""
+        self.inputs = {}
         self.warnings: list[str] = []
         self._data_nodes: list = []
         self.action = None  # slicer.vtkSlicerVolumeCuttingLogic.ToolCut or ToolRestore inside a stroke
@@ -276,6 +277,8 @@ class DrillSession:
         self.volume, self.segmentation, self.bone_segmentation = volume, roles_segmentation, bone
         self.cut_node, self.tool_node, self.description = cut_node, tool, description
         self.source = source
+        # The user's files, for a recording that names its scan by them (sessionrecording.scan_descriptor).
+        self.inputs = {"ct": ct_path, "segmentation": segmentation_path, "color_table": color_table} if source == "own" else {}
         self.warnings = warnings
         yield 1.0, "Ready"
 
@@ -399,9 +402,11 @@ class DrillSession:
         """Move the tool to ``pose``; inside a stroke it cuts (or restores) along the way."""
         self._require_data()
         action = self.action if self.action is not None else slicer.vtkSlicerVolumeCuttingLogic.ToolMove
+        moved = bool(self.logic.MoveActiveTool(self.cut_node, pose, action))
+        # After the move: the listener reads what the pose did (the nerve monitor's readings there).
         if self.action is not None and self.stroke_listener is not None:
             self.stroke_listener.tool_moved(pose)
-        return bool(self.logic.MoveActiveTool(self.cut_node, pose, action))
+        return moved
 
     def end_stroke(self) -> bool:
         """Close the open stroke (nothing happens without one); the tables are updated."""

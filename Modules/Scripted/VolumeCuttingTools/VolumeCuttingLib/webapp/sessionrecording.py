@@ -5,19 +5,20 @@ stroke_listener``: strokes, poses, undo and redo, where the session drives
 the logic) and to the 3D view's rendered frames, and keeps a version 2
 recording (``cutting.recording.SessionRecorder``): each stroke's poses with
 their times, the tool of each stroke (a key per tool setting, with the
-parameters that rebuild it), undo/redo, the camera of rendered frames (at most
-``CAMERA_RATE_HZ``, and a still camera once a second), the contacts with
-structures the tool may not cut and the removed volume per segment after each
-stroke and edit. New data starts a new recording.
+parameters that rebuild it), undo/redo, the camera of every frame the 3D
+view draws (its full view and its fast preview), the nerve monitor's readings
+at each pose (those that changed, ``cutting.recording.MonitorCompactor``),
+the contacts with structures the tool may not cut and the removed volume per
+segment after each stroke and edit. New data starts a new recording.
 
 ``replay_in`` drills a downloaded recording into a session on the same data
 through the logic (``cutting.recording.replay``), the tools rebuilt from the
 recording: the cut is the one the page made, voxel for voxel.
 
 ``ReportPanel`` grades the session so far with ``VolumeCuttingLib.
-assessment`` (against the shipped careful mastoidectomy when the scan is
-one the assessment rebuilds, the phantom or the example head CT; without a
-reference otherwise), shows the score, the key metrics and the report's
+assessment`` (against the shipped careful mastoidectomy on the phantom and
+the example head CT; on the user's own CT with their segmentation without a
+reference, the regions and structures at risk theirs), shows the score, the key metrics and the report's
 plots, offers the recording (JSON with its sha256) and the self-contained
 HTML report as downloads, and stores the assessment in the trainee records
 (``records.pending.store_or_keep``: an unreachable database keeps it pending,
@@ -44,9 +45,6 @@ from ..records import pending
 from ..records.assessment import AssessmentError as RecordsAssessmentError
 from . import session as sessionlib
 
-# Rendered frames come at up to 60 a second; the visibility metric needs the camera where the burr works.
-CAMERA_RATE_HZ = 10.0
-STILL_CAMERA_PERIOD_S = 1.0
 #: What the panel lists beside the score (those the assessment computed).
 KEY_METRICS = (
     ("safety.contacts", "contacts with structures at risk", ""),
@@ -72,7 +70,18 @@ def tool_entry(params: toolconfig.ToolParameters) -> dict:
 
 
 def scan_descriptor(session) -> dict | None:
-    """The assessment's descriptor of the session's scan, when the assessment rebuilds it on the same voxel grid."""
+    """The assessment's descriptor of the session's scan, when the assessment rebuilds it on the same voxel grid.
+
+    The user's own scan with their segmentation is named by its files and
+    the roles given on the page when the recording is taken (by name).
+    """
+    cut_node = session.cut_node
+    if session.source == "own" and session.inputs.get("segmentation") is not None:
+        if not cut_node.GetCuttableSegmentIDs():
+            return None
+        return scans.own_descriptor(session.volume, session.segmentation, list(cut_node.GetCuttableSegmentIDs()),
+                                    list(cut_node.GetProtectedSegmentIDs()), session.inputs["ct"],
+                                    session.inputs["segmentation"], session.inputs.get("color_table"))
     if session.source == "phantom":
         scan = scans.phantom_scan(dimensions=list(sessionlib.PHANTOM_DIMENSIONS), spacing=list(sessionlib.PHANTOM_SPACING), seed=0)
     elif session.source == "headct":
@@ -98,7 +107,6 @@ class WebSessionRecording:
         self._stroke_action = None
         self._stroke_open = False
         self._contacts_seen = 0
-        self._last_frame = None  # (time, camera row)
         session.stroke_listener = self
 
     # -- the recorder of the current data
@@ -114,7 +122,6 @@ class WebSessionRecording:
             self.recorder = recordings.SessionRecorder(self._tools, description=f"Web session on {self.session.description}",
                                                        **options)
             self._stroke_open = False
-            self._last_frame = None
             table = self.session.logic.GetContactTableNode(self._cut_node)
             self._contacts_seen = table.GetNumberOfRows() if table is not None else 0
         return self.recorder
@@ -143,7 +150,11 @@ class WebSessionRecording:
             rotation = [[pose.GetElement(r, c) for c in range(3)] for r in range(3)]
             recorder.begin_stroke(self._tool_key(), self._stroke_action, rotation)
             self._stroke_open = True
-        recorder.pose([pose.GetElement(r, 3) for r in range(3)])
+        # The session tells after the logic moved the tool: the monitor reads at this pose.
+        monitor = self.session.logic.GetNerveMonitor(self.session.cut_node)
+        if monitor is not None and "monitor" not in recorder.recording:
+            recorder.monitor(monitor)
+        recorder.pose([pose.GetElement(r, 3) for r in range(3)], readings=recordings.monitor_readings(monitor))
 
     def stroke_ended(self) -> None:
         recorder = self._current()
@@ -180,18 +191,15 @@ class WebSessionRecording:
                                              lambda *_, renderer=renderer: self.frame_rendered(renderer.GetActiveCamera()))
 
     def frame_rendered(self, camera) -> None:
-        """A frame of the 3D view was drawn with ``camera``: kept when the camera moved, at most CAMERA_RATE_HZ."""
+        """A frame of the 3D view was drawn with ``camera``: its camera is recorded (every frame, as the trainee saw it)."""
         recorder = self._current()
-        if recorder is None:
-            return
-        now = recorder.now()
-        row = (*camera.GetPosition(), *camera.GetFocalPoint(), *camera.GetViewUp(), camera.GetViewAngle())
-        if self._last_frame is not None:
-            since = now - self._last_frame[0]
-            if since < 1.0 / CAMERA_RATE_HZ or (row == self._last_frame[1] and since < STILL_CAMERA_PERIOD_S):
-                return
-        recorder.camera(row[0:3], row[3:6], row[6:9], row[9])
-        self._last_frame = (now, row)
+        if recorder is not None:
+            recorder.camera(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle())
+
+    @property
+    def camera_frame_count(self) -> int:
+        """The cameras recorded for the data now loaded (one per frame drawn since it was loaded)."""
+        return len(self.recorder.recording["camera"]["frames"]) if self.recorder is not None and self._cut_node is self.session.cut_node else 0
 
     # -- what leaves the session
 
@@ -299,8 +307,9 @@ class ReportPanel:
             if not snapshot["strokes"]:
                 raise sessionlib.SessionError("Nothing to grade yet: drill first (Drill mode, press and drag on the bone)")
             if "scan" not in snapshot:
-                raise sessionlib.SessionError("This scan is not one the assessment can rebuild (the phantom or the example "
-                                              "head CT): the recording can be downloaded, not graded here")
+                raise sessionlib.SessionError("This scan is not one the assessment can rebuild (the phantom, the example "
+                                              "head CT, or your CT with your segmentation and its cuttable segments): "
+                                              "the recording can be downloaded, not graded here")
             # The server keeps what it graded: the records name the file, and it outlives the page.
             stamp = snapshot["started"].replace(":", "").replace("+0000", "Z")
             path = recordings.save(snapshot, self.work_directory / "recordings" / f"session-{stamp}-{len(snapshot['strokes'])}.json")
