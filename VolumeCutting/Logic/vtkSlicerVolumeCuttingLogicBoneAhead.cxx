@@ -95,16 +95,21 @@ double vtkSlicerVolumeCuttingLogic::MeasureBoneAhead(vtkMRMLVolumeCutNode* cutNo
 {
   const double nothing = std::numeric_limits<double>::infinity();
   vtkMRMLVolumeCutToolNode* toolNode = GetActiveTool(cutNode);
-  vtkVolumeCutTool* tool = toolNode ? this->GetCuttingTool(toolNode) : nullptr;
-  vtkVolumeCutBoneAhead* query = tool && toolToRAS ? this->GetBoneAhead(cutNode) : nullptr;
+  vtkVolumeCutBoneAhead* query = toolNode && toolToRAS ? this->GetBoneAhead(cutNode) : nullptr;
   if (!query)
   {
     return nothing;
   }
-  // From the tip of the cutting part, away from the handpiece (the shaft is local +z).
-  double halfExtents[3];
-  tool->GetLocalHalfExtents(halfExtents);
-  const double tipLocal[4] = { 0.0, 0.0, -halfExtents[2], 1.0 };
+  // From the tip of the cutting part, away from the handpiece (the shaft is local +z): the round burr's
+  // radius (swept as a capsule, it has no tool object), or the extent along the shaft of the other shapes.
+  double reach = toolNode->GetCuttingRadius();
+  if (vtkVolumeCutTool* tool = this->GetCuttingTool(toolNode))
+  {
+    double halfExtents[3];
+    tool->GetLocalHalfExtents(halfExtents);
+    reach = halfExtents[2];
+  }
+  const double tipLocal[4] = { 0.0, 0.0, -reach, 1.0 };
   double tip[4];
   toolToRAS->MultiplyPoint(tipLocal, tip);
   const double ahead[3] = { -toolToRAS->GetElement(0, 2), -toolToRAS->GetElement(1, 2), -toolToRAS->GetElement(2, 2) };
