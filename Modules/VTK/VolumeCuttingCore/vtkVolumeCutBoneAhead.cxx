@@ -9,6 +9,7 @@
 #include <vtkMatrix4x4.h>
 #include <vtkObjectFactory.h>
 #include <vtkPointData.h>
+#include <vtkType.h>
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,18 @@ void TransformPoint(const double m[16], const double p[3], double out[3])
   {
     out[row] = m[4 * row] * p[0] + m[4 * row + 1] * p[1] + m[4 * row + 2] * p[2] + m[4 * row + 3];
   }
+}
+
+template <typename T>
+size_t CopyNonZero(const T* values, std::vector<uint8_t>& mask)
+{
+  size_t nonZero = 0;
+  for (size_t n = 0; n < mask.size(); ++n)
+  {
+    mask[n] = values[n] != T(0) ? 1 : 0;
+    nonZero += mask[n];
+  }
+  return nonZero;
 }
 
 void TransformVector(const double m[16], const double v[3], double out[3])
@@ -70,10 +83,13 @@ bool vtkVolumeCutBoneAhead::SetBone(vtkImageData* labels, vtkMatrix4x4* ijkToRAS
   }
   std::vector<uint8_t> mask(static_cast<size_t>(scalars->GetNumberOfTuples()));
   size_t boneVoxels = 0;
-  for (vtkIdType n = 0; n < scalars->GetNumberOfTuples(); ++n)
+  // Read in the array's own type: a scan's label map has tens of millions of voxels.
+  switch (scalars->GetDataType())
   {
-    mask[n] = scalars->GetTuple1(n) != 0.0 ? 1 : 0;
-    boneVoxels += mask[n];
+    vtkTemplateMacro(boneVoxels = CopyNonZero(static_cast<const VTK_TT*>(scalars->GetVoidPointer(0)), mask));
+    default:
+      vtkErrorMacro("SetBone: the bone labels' scalar type " << scalars->GetDataTypeAsString() << " is not a number");
+      return false;
   }
   if (boneVoxels == 0)
   {
