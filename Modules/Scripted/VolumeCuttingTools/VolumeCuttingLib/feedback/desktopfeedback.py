@@ -56,6 +56,7 @@ class DesktopFeedback:
         """Follow ``cut_node``; with ``sound``, open the audio stream. Whether the drill sound plays."""
         self.cut_node = cut_node
         self.source.stroke_ended()
+        self.source.prepare(cut_node)
         self.rows, self.rows_changed = [], True
         return self.set_sound(sound)
 

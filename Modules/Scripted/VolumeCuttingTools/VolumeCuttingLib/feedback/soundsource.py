@@ -50,6 +50,12 @@ class DrillSoundSource:
         if self.drill_on:
             self.meter.update(removed_mm3, time.monotonic() if time_s is None else time_s)
 
+    def prepare(self, cut_node) -> None:
+        """Make the bone-ahead query (the bone's mask from the cuttable segments: a pass over the scan) before
+        the first stroke, so that the first tick of the sound does not wait for it."""
+        if cut_node is not None:
+            self.logic.GetBoneAhead(cut_node)
+
     def bone_ahead_mm(self, cut_node) -> float:
         """The bone left ahead of the tool's tip (mm; inf when none is ahead or nothing is known)."""
         if cut_node is None:

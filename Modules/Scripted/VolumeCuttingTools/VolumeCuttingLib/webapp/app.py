@@ -435,6 +435,7 @@ class VolumeCuttingApp(TrameApp):
         self.softcut.show_skin(bool(self.state.vc_sc_skin))
         self._refresh_softcut(error="")
         self.monitor_meter.refresh(force=True)
+        self.sound.prepare()
         self._request_monitor_refresh()
         self.reset_camera()
 

@@ -50,6 +50,11 @@ class SoundFeed:
         """The sound's configuration for the page (``vc_sound_config``), sent once: not in every update."""
         return dataclasses.asdict(self.config)
 
+    def prepare(self) -> None:
+        """New data: the bone-ahead query is made now, not at the first stroke."""
+        if self.session.has_data:
+            self.source.prepare(self.session.cut_node)
+
     def parameters(self) -> drillsound.SoundParameters:
         if not self.session.has_data:
             return drillsound.SoundParameters()
