@@ -15,7 +15,6 @@ import math
 
 import numpy as np
 import pytest
-import slicer
 import vtk
 
 from test_haptic_session import add_burr, block_scene

@@ -1,9 +1,9 @@
 """The desktop's nerve-monitor meter and drill sound (VolumeCuttingLib.feedback.desktopfeedback and
 soundsource), headless against a real scene, with the audio output's no-device path and a stand-in stream.
 
-The scene: a plate of bone (cuttable) whose labelled voxels end at x = 4.75 mm,
-and a nerve canal (protected) along z at x = 2, y = 4.5 mm, radius ~1 mm, in
-the bone beside the burr's path. A 4 mm burr (radius 2) drills along +x at
+The scene (``data.boneplate``): a plate of bone (cuttable) whose labelled
+voxels end at x = 4.75 mm, and a nerve canal (protected) along z at x = 2,
+y = 4.5 mm, radius ~1 mm, in the bone beside the burr's path. A 4 mm burr (radius 2) drills along +x at
 y = z = 0 with its shaft behind it: the bone ahead of its tip is the plate's
 far side, 4.75 - x - 2 mm away; the nerve is to its side, farther than the
 wall is thin (the stand-in the sound used before, the distance to the nearest
@@ -12,62 +12,29 @@ protected structure, reads 0.5-1 mm more there).
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import pytest
-import vtk
 
 from VolumeCuttingLib.config import toolconfig
-from VolumeCuttingLib.feedback import audioout, desktopfeedback, drillsound, nervemonitor, soundanalysis, soundsource
-from VolumeCuttingLib.scene import nodes
+from VolumeCuttingLib.data import boneplate
+from VolumeCuttingLib.feedback import desktopfeedback, drillsound, nervemonitor, soundanalysis, soundsource
 from VolumeCuttingLib.scene.application import HeadlessSlicer
 
-SPACING = 0.5
-FAR_FACE_X = 4.75
 BURR_RADIUS = 2.0
-HALF_VOXEL = 0.5 * SPACING
-
-
-def plate_scene():
-    application = HeadlessSlicer()
-    shape = (24, 28, 40)  # k, j, i
-    ijk_to_ras = np.diag([SPACING, SPACING, SPACING, 1.0])
-    ijk_to_ras[:3, 3] = [-10.0, -7.0, -6.0]
-    k, j, i = np.mgrid[0:shape[0], 0:shape[1], 0:shape[2]]
-    x, y = -10.0 + SPACING * i, -7.0 + SPACING * j
-    bone = (x > -5.2) & (x < 4.7)
-    ct = np.where(bone, 1200, -1000).astype(np.int16)
-    volume = nodes.create_scalar_volume_node(application.scene, ct, ijk_to_ras, "CT")
-    labels = np.zeros(shape, np.uint8)
-    labels[bone] = 1
-    labels[bone & ((x - 2.0) ** 2 + (y - 4.5) ** 2 <= 1.0)] = 2
-    segmentation = nodes.create_segmentation_from_labels(application.scene, volume, labels, {1: "Bone", 2: "Nerve"}, "Anatomy")
-    logic = application.volume_cutting_logic
-    cut = logic.AddVolumeCutNode(volume, segmentation)
-    cut.SetCuttableSegmentIDs(["Bone"])
-    cut.SetProtectedSegmentIDs(["Nerve"])
-    cut.SetSurfaceIsoValue(300.0)
-    preset = next(p for p in toolconfig.load_presets() if p.name == "Cutting burr 4 mm")
-    tool = toolconfig.create_tool_node(application.scene, toolconfig.from_preset(preset), name=preset.name)
-    cut.SetAndObserveActiveToolNodeID(tool.GetID())
-    assert nervemonitor.monitor_for(logic, cut) is not None  # waits for the nerve's distance field
-    return application, logic, cut, tool
-
-
-def pose_along_x(x):
-    """The burr at (x, 0, 0), its shaft (local z) along -x: it drills towards +x."""
-    matrix = vtk.vtkMatrix4x4()
-    matrix.DeepCopy((0.0, 0.0, -1.0, float(x),
-                     0.0, 1.0, 0.0, 0.0,
-                     1.0, 0.0, 0.0, 0.0,
-                     0.0, 0.0, 0.0, 1.0))
-    return matrix
+HALF_VOXEL = 0.5 * boneplate.SPACING
+FAR_FACE_X = boneplate.FAR_FACE_X
+pose_along_x = boneplate.drilling_pose
 
 
 @pytest.fixture(scope="module")
 def scene():
-    return plate_scene()
+    application = HeadlessSlicer()
+    burr = toolconfig.from_preset(next(p for p in toolconfig.load_presets() if p.name == "Cutting burr 4 mm"))
+    tool = toolconfig.create_tool_node(application.scene, burr, name="burr")
+    cut = boneplate.plate_with_nerve(application, tool)
+    assert nervemonitor.monitor_for(application.volume_cutting_logic, cut) is not None  # waits for the nerve's field
+    return application, application.volume_cutting_logic, cut, tool
 
 
 def test_the_sound_hears_the_wall_ahead_thin_not_the_nearest_structure(scene):
