@@ -45,8 +45,15 @@ def test_the_sound_hears_the_wall_ahead_thin_not_the_nearest_structure(scene):
     checked = 0
     for step, x in enumerate(np.arange(-8.0, 2.01, 0.25)):
         assert logic.MoveActiveTool(cut, pose_along_x(x), logic.ToolCut)
-        source.note_removed(logic.GetRemovedVolume(cut), time_s=0.02 * (step + 1))
+        source.note_removed(source.removed_bone_mm3(cut), time_s=0.02 * (step + 1))
         parameters = source.parameters(cut, tool)
+        # Load is bone removed: the burr sweeping air (the plate's near face is at x = -5.25, its voxels' partial
+        # volume half a voxel either side) is not on bone.
+        tip = x + BURR_RADIUS
+        if abs(tip + 5.25) > HALF_VOXEL:
+            assert parameters.contact == (tip > -5.25), x
+        if tip > -4.0:
+            assert parameters.load > 0.5, x
         wall = FAR_FACE_X - x - BURR_RADIUS
         if wall < 4.0 - HALF_VOXEL:
             assert parameters.thickness_mm == pytest.approx(wall, abs=HALF_VOXEL), x

@@ -12,9 +12,9 @@ the same computation the web application's feed publishes.
 
 Sampling. The monitor's readings and the bone ahead are read at every tick
 (the logic measures the monitor at every pose; the bone ahead costs tens of
-microseconds). The removed volume, whose rate is the load, is sampled every
-``REMOVED_PERIOD_S`` only: it sums the cut field, which costs milliseconds
-on a large scan.
+microseconds). The removed volume of bone, whose rate is the load, is
+sampled every ``REMOVED_PERIOD_S`` only: it sums the cut's removed voxels
+per segment, whose cost grows with the cut.
 
 Without an audio device the meter still runs: :meth:`start` returns False
 and :attr:`message` says why the session goes on silent.
@@ -86,7 +86,7 @@ class DesktopFeedback:
         self.rows, self.rows_changed = [], True
 
     def _removed_mm3(self) -> float:
-        return float(self.logic.GetRemovedVolume(self.cut_node)) if self.cut_node is not None else 0.0
+        return self.source.removed_bone_mm3(self.cut_node)
 
     def tick(self, drill_on: bool, now_s: float | None = None) -> list[dict]:
         """One display tick: read the monitor, follow the drill switch, hand the sound its parameters; the rows."""

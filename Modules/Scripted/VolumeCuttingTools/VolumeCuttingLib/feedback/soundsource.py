@@ -6,10 +6,10 @@ One computation, so that both hear the same drill:
 
 * the motor: the drill switch (a stroke is the foot pedal) and the tool
   node's speed times its power;
-* load: the removal rate (mm3/s) of the current stroke, from the removed
-  volume the owner samples a few times a second (``note_removed``; asking
-  the logic for it at every tick would cost tens of ms while the field
-  changes);
+* load: the removal rate (mm3/s) of bone in the current stroke, from the
+  removed volume the owner samples a few times a second (``note_removed``,
+  e.g. ``removed_bone_mm3``; asking the logic for it at every tick would
+  cost tens of ms while the field changes);
 * the bone ahead: ``vtkSlicerVolumeCuttingLogic.MeasureBoneAhead``, the wall
   left ahead of the burr's tip along its axis, measured as the renderer's
   thin-bone tint measures walls (``vtkVolumeCutBoneAhead``);
@@ -49,6 +49,14 @@ class DrillSoundSource:
         """The removed volume (mm3) just sampled: the removal rate follows from it while the drill is on."""
         if self.drill_on:
             self.meter.update(removed_mm3, time.monotonic() if time_s is None else time_s)
+
+    def removed_bone_mm3(self, cut_node) -> float:
+        """The volume (mm3) removed inside the cut node's cuttable segments: what loads the burr (air the burr
+        sweeps through is removed from the cut field too, but costs it nothing)."""
+        if cut_node is None:
+            return 0.0
+        volumes = (self.logic.GetRemovedVolumeInSegment(cut_node, segment_id) for segment_id in cut_node.GetCuttableSegmentIDs())
+        return float(sum(volume for volume in volumes if volume > 0.0))
 
     def prepare(self, cut_node) -> None:
         """Make the bone-ahead query (the bone's mask from the cuttable segments: a pass over the scan) before
