@@ -177,6 +177,7 @@ void vtkSlicerVolumeCuttingLogic::ForgetNode(const std::string& nodeId)
   this->ReportedContactDepths.erase(nodeId);
   this->ToolCache->Forget(nodeId);
   this->NerveMonitors->Forget(nodeId);
+  this->BoneAheadQueries.erase(nodeId);
   this->StrokePoses.erase(nodeId);
 }
 
@@ -192,6 +193,7 @@ void vtkSlicerVolumeCuttingLogic::ForgetAllNodes()
   this->ReportedContactDepths.clear();
   this->ToolCache->ForgetAll();
   this->NerveMonitors->ForgetAll();
+  this->BoneAheadQueries.clear();
   this->StrokePoses.clear();
 }
 

@@ -36,6 +36,7 @@ class vtkIdTypeArray;
 class vtkSlicerVolumeCuttingSegmentLayers;
 class vtkSlicerVolumeCuttingNerveMonitors;
 class vtkSlicerVolumeCuttingToolCache;
+class vtkVolumeCutBoneAhead;
 class vtkVolumeCutNerveMonitor;
 class vtkMRMLScalarVolumeNode;
 class vtkMRMLSegmentationNode;
@@ -220,6 +221,24 @@ public:
   };
   ///@}
 
+  ///@{
+  /// The bone left ahead of the active tool (mm), for the drill sound whose
+  /// pitch rises as it thins (seed 003): measured from the tip of the
+  /// cutting part (its half extent along the shaft) along the tool's axis,
+  /// away from the handpiece (local -z), through the node's cuttable
+  /// segments less what the cut field removed, as the renderer's thin-bone
+  /// tint measures walls (vtkVolumeCutBoneAhead: quarter-voxel march, the
+  /// crossings halved to 1/256 of a voxel). +inf when no bone begins within
+  /// the query's Range (4 mm) ahead, at most its MaximumThickness (4 mm);
+  /// +inf as well without an active tool or a cuttable segment with voxels
+  /// (nothing can thin). The pose is the tool's own (its parent transform)
+  /// unless given. GetBoneAhead gives the query, made from the segments'
+  /// labels on the anatomy's grid when they change (nullptr: no bone).
+  double MeasureBoneAhead(vtkMRMLVolumeCutNode* cutNode);
+  double MeasureBoneAhead(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* toolToRAS);
+  vtkVolumeCutBoneAhead* GetBoneAhead(vtkMRMLVolumeCutNode* cutNode);
+  ///@}
+
   /// Volume (mm^3) removed inside a segment: the cut field's removed fraction
   /// of each anatomy voxel, summed over the segment's voxels (resampled to the
   /// anatomy's grid if needed). A shielded segment reports exactly 0 where
@@ -368,6 +387,14 @@ protected:
   bool NerveMonitoring = true;
   /// New readings for the active tool at a pose; invokes the event on a change of level.
   void UpdateNerveMonitor(vtkMRMLVolumeCutNode* cutNode, vtkMatrix4x4* toolToRAS);
+  /// The bone-ahead query of each cut node and what its bone was made from, per cut-node ID.
+  struct BoneAheadQuery
+  {
+    std::string Source;
+    vtkSmartPointer<vtkVolumeCutBoneAhead> Query;
+  };
+  std::map<std::string, BoneAheadQuery> BoneAheadQueries;
+
   /// The active tool's last pose in the open stroke, per cut-node ID.
   std::map<std::string, vtkSmartPointer<vtkMatrix4x4>> StrokePoses;
 

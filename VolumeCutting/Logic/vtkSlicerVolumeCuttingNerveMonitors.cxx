@@ -113,26 +113,7 @@ vtkVolumeCutNerveMonitor* vtkSlicerVolumeCuttingNerveMonitors::GetMonitor(vtkMRM
     return nullptr;
   }
   std::ostringstream source;
-  for (const std::string& id : wanted)
-  {
-    source << id << ";";
-  }
-  // The grid by its values, not the node's modification time (which any reference or attribute change bumps).
-  vtkNew<vtkMatrix4x4> grid;
-  anatomy->GetIJKToRASMatrix(grid);
-  // Each segment's labels by their own modification time: the segmentation's
-  // is bumped by more than a change of the monitored segments' voxels.
-  for (const std::string& id : wanted)
-  {
-    vtkSegment* segment = segmentation->GetSegmentation()->GetSegment(id);
-    vtkDataObject* labels = segment ? segment->GetRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName()) : nullptr;
-    source << (labels ? labels->GetMTime() : 0) << ",";
-  }
-  source << anatomy->GetImageData()->GetMTime() << ";";
-  for (int element = 0; element < 16; ++element)
-  {
-    source << grid->GetElement(element / 4, element % 4) << ",";
-  }
+  source << vtkSlicerVolumeCuttingSegmentImages::DescribeLabelSource(anatomy, segmentation, wanted);
   source << ";" << cutNode->GetLabelSmoothing();
   if (source.str() == state->Source)
   {

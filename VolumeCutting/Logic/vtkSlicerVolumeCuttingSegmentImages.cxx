@@ -32,6 +32,7 @@
 
 // STD includes
 #include <algorithm>
+#include <sstream>
 
 vtkStandardNewMacro(vtkSlicerVolumeCuttingSegmentImages);
 
@@ -54,6 +55,35 @@ void vtkSlicerVolumeCuttingSegmentImages::GetAnatomyGeometry(vtkMRMLScalarVolume
   anatomy->GetIJKToRASMatrix(ijkToRas);
   geometry->SetImageToWorldMatrix(ijkToRas);
   geometry->SetExtent(anatomy->GetImageData()->GetExtent());
+}
+
+//----------------------------------------------------------------------------
+std::string vtkSlicerVolumeCuttingSegmentImages::DescribeLabelSource(
+  vtkMRMLScalarVolumeNode* anatomy, vtkMRMLSegmentationNode* segmentation, const std::vector<std::string>& segmentIds)
+{
+  std::ostringstream source;
+  for (const std::string& id : segmentIds)
+  {
+    source << id << ";";
+  }
+  if (!anatomy || !anatomy->GetImageData() || !segmentation || !segmentation->GetSegmentation())
+  {
+    return source.str();
+  }
+  for (const std::string& id : segmentIds)
+  {
+    vtkSegment* segment = segmentation->GetSegmentation()->GetSegment(id);
+    vtkDataObject* labels = segment ? segment->GetRepresentation(vtkSegmentationConverter::GetBinaryLabelmapRepresentationName()) : nullptr;
+    source << (labels ? labels->GetMTime() : 0) << ",";
+  }
+  source << anatomy->GetImageData()->GetMTime() << ";";
+  vtkNew<vtkMatrix4x4> grid;
+  anatomy->GetIJKToRASMatrix(grid);
+  for (int element = 0; element < 16; ++element)
+  {
+    source << grid->GetElement(element / 4, element % 4) << ",";
+  }
+  return source.str();
 }
 
 //----------------------------------------------------------------------------

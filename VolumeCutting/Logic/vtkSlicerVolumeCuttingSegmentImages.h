@@ -49,6 +49,13 @@ public:
   static std::vector<std::string> CreateLabelMap(vtkMRMLScalarVolumeNode* anatomy, vtkMRMLSegmentationNode* segmentation,
                                                  const std::vector<std::string>& segmentIds, vtkImageData* labels);
 
+  /// A text that changes when the labels CreateLabelMap would give for these
+  /// segments change: the anatomy's grid by its values and each segment's
+  /// binary labels by their own modification time (the segmentation's is
+  /// bumped by more than a change of voxels: a colour, a name, a tint).
+  static std::string DescribeLabelSource(vtkMRMLScalarVolumeNode* anatomy, vtkMRMLSegmentationNode* segmentation,
+                                         const std::vector<std::string>& segmentIds);
+
   /// The fraction (0..1 float, IJK geometry) of each anatomy voxel inside a
   /// segment that has a fractional labelmap representation, resampled
   /// linearly. Returns false (nothing written) when the segment has none.

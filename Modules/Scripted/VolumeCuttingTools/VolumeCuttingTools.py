@@ -26,6 +26,7 @@ from slicer.util import VTKObservationMixin
 
 from VolumeCuttingLib.config import hapticdrilling, inputdevices, toolconfig
 from VolumeCuttingLib.data import headct, phantom
+from VolumeCuttingLib.feedback import desktopfeedback
 from VolumeCuttingLib.jobs import selftests
 
 # Read once: the parameter node's choices are fixed when the module loads.
@@ -112,6 +113,7 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self._parameterNodeGuiTag = None
         self._drilling = None
         self._drillTimer = None
+        self._feedback = None
 
     def setup(self) -> None:
         ScriptedLoadableModuleWidget.setup(self)
@@ -133,9 +135,12 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self.ui.refreshDevicesButton.connect("clicked(bool)", self.onRefreshDevices)
         self.ui.inputDeviceComboBox.connect("currentIndexChanged(int)", self.onInputDeviceChanged)
         self.ui.drillButton.connect("toggled(bool)", self.onDrillToggled)
-        # The scene follows the haptic thread at display rate.
+        self.ui.drillSoundCheckBox.connect("toggled(bool)", self.onDrillSoundToggled)
+        self.ui.soundVolumeSliderWidget.connect("valueChanged(double)", self.onSoundVolumeChanged)
+        # The scene follows the haptic thread at display rate; the monitor's meter and the drill sound's
+        # parameters follow at the same rate (at least the 50 Hz the sound needs).
         self._drillTimer = qt.QTimer()
-        self._drillTimer.setInterval(16)
+        self._drillTimer.setInterval(round(desktopfeedback.TICK_PERIOD_S * 1000))
         self._drillTimer.connect("timeout()", self.onDrillTimer)
         self.onRefreshDevices()
         self.initializeParameterNode()
@@ -284,15 +289,54 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
             self.ui.drillButton.checked = False
             self.ui.drillButton.blockSignals(wasBlocked)
             return
+        self._feedback = self.logic.startFeedback(
+            self._parameterNode, sound=self.ui.drillSoundCheckBox.checked, volume=self.ui.soundVolumeSliderWidget.value)
+        self.ui.soundStatusLabel.text = self._feedback.message
         self._drillTimer.start()
 
     def onDrillTimer(self) -> None:
         if self._drilling is not None:
             self._drilling.update()
+            if self._feedback is not None:
+                rows = self._feedback.tick(self._drilling.drilling)
+                if self._feedback.rows_changed:
+                    self._showMonitorRows(rows)
+
+    def onDrillSoundToggled(self, checked: bool) -> None:
+        if self._feedback is not None:
+            self._feedback.set_sound(checked)
+            self.ui.soundStatusLabel.text = self._feedback.message
+
+    def onSoundVolumeChanged(self, volume: float) -> None:
+        if self._feedback is not None:
+            self._feedback.set_volume(volume)
+
+    def _showMonitorRows(self, rows) -> None:
+        """The meter: per structure its name, a distance bar (0-8 mm) and the level, in the level's colour."""
+        table = self.ui.monitorTable
+        table.setRowCount(len(rows))
+        for index, row in enumerate(rows):
+            nameItem = qt.QTableWidgetItem(row["name"])
+            table.setItem(index, 0, nameItem)
+            bar = table.cellWidget(index, 1)
+            if bar is None:
+                bar = qt.QProgressBar()
+                bar.setRange(0, 1000)
+                table.setCellWidget(index, 1, bar)
+            bar.setValue(round(row["bar"] * 1000))
+            bar.setFormat("not ready" if row["mm"] is None else f"{row['mm']:.2f} mm")
+            bar.setStyleSheet(f"QProgressBar::chunk {{ background-color: {row['colour']}; }}")
+            levelItem = qt.QTableWidgetItem(row["level"])
+            levelItem.setBackground(qt.QBrush(qt.QColor(row["colour"])))
+            table.setItem(index, 2, levelItem)
 
     def _stopDrilling(self) -> None:
         if self._drillTimer is not None:
             self._drillTimer.stop()
+        if self._feedback is not None:
+            self._feedback.stop()
+            self._feedback = None
+            self._showMonitorRows([])
         if self._drilling is not None:
             self._drilling.stop()
             self._drilling = None
@@ -366,6 +410,14 @@ class VolumeCuttingToolsLogic(ScriptedLoadableModuleLogic):
         drilling.start(parameterNode.cutNode, parameterNode.inputDevice, renderer, interactor,
                        foot_switch=footSwitch, falcon_firmware=falconFirmware)
         return drilling
+
+    def startFeedback(self, parameterNode, sound: bool = True, volume: float = 1.0) -> desktopfeedback.DesktopFeedback:
+        """The nerve monitor's meter and the drill sound for the parameter node's cut session (silent, with a
+        message, without an audio device)."""
+        feedback = desktopfeedback.DesktopFeedback(slicer.modules.volumecutting.logic())
+        feedback.set_volume(volume)
+        feedback.start(parameterNode.cutNode, sound=sound)
+        return feedback
 
 
 #

@@ -34,7 +34,7 @@ def test_the_listed_mouse_drills_and_stop_gives_the_mouse_back_to_the_camera():
     mouse = next(device for device in inputdevices.list_devices() if device.device_id == inputdevices.MOUSE_DEVICE_ID)
     drilling.start(cut, mouse.device_id, renderer, interactor)
     try:
-        assert drilling.running
+        assert drilling.running and not drilling.drilling  # the drill runs only while its button is held
         with pytest.raises(HapticDrillingError, match="running already"):
             drilling.start(cut, mouse.device_id, renderer, interactor)
         event(interactor, "MouseMoveEvent", SIZE // 2, SIZE // 2)
@@ -43,7 +43,10 @@ def test_the_listed_mouse_drills_and_stop_gives_the_mouse_back_to_the_camera():
             event(interactor, "MouseWheelForwardEvent", SIZE // 2, SIZE // 2)
             run_frames(drilling, 0.05)
         run_frames(drilling, 0.3)
+        assert drilling.drilling  # what the desktop's drill sound follows
         event(interactor, "LeftButtonReleaseEvent", SIZE // 2, SIZE // 2)
+        run_frames(drilling, 0.05)
+        assert not drilling.drilling
         assert tool_position(tool)[0] + 2.0 > -7.5  # the burr went past the block's face
     finally:
         drilling.stop()

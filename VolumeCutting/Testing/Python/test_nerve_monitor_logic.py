@@ -45,7 +45,7 @@ def test_the_logic_monitors_the_protected_nerve_as_the_tool_moves():
         # What the drill sound mixes in: a level it knows, the rate the monitor fires at.
         sound_level, sound_rate = nervemonitor.sound_input(monitor)
         assert sound_level in drillsound.MONITOR_LEVELS and sound_rate == reading["firing_rate_hz"]
-        assert nervemonitor.nearest_mm(monitor) == reading["distance_mm"]  # the drill sound's bone ahead
+        assert nervemonitor.nearest_mm(monitor) == reading["distance_mm"]  # the only structure is the nearest
         sounds.append(sound_level)
         expected = NERVE_END_X - x - BURR_RADIUS
         assert abs(reading["distance_mm"] - expected) < 0.1, (x, reading)

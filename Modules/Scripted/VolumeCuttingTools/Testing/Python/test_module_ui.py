@@ -2,8 +2,10 @@
 
 Desktop Slicer is not available here, so the checks that can be made without
 it are made statically: the module compiles, every ``SlicerParameterName`` in
-the .ui is a parameter of the parameter node, and every ``self.ui.<name>``
-the widget uses is a widget of the .ui.
+the .ui is a parameter of the parameter node, every ``self.ui.<name>``
+the widget uses is a widget of the .ui, and what it asks of the Qt-free
+controllers (the nerve monitor's meter and drill sound, the drilling
+session) exists there.
 """
 
 import ast
@@ -55,6 +57,34 @@ def test_widgets_the_module_uses_are_in_the_ui():
             if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute) and node.value.attr == "ui"}
     assert used, "no self.ui.<widget> found: the check would prove nothing"
     assert used <= set(ui_widgets()), used - set(ui_widgets())
+
+
+def attributes_used_on(owner: str) -> set:
+    """The names the module reads from ``<...>.<owner>.<name>`` or ``<owner>.<name>``."""
+    used = set()
+    for node in ast.walk(ast.parse(MODULE_FILE.read_text())):
+        if isinstance(node, ast.Attribute):
+            value = node.value
+            if (isinstance(value, ast.Attribute) and value.attr == owner) or (isinstance(value, ast.Name) and value.id == owner):
+                used.add(node.attr)
+    return used
+
+
+def test_the_widget_asks_the_desktop_controllers_only_for_what_they_have():
+    from VolumeCuttingLib.config import hapticdrilling
+    from VolumeCuttingLib.feedback import desktopfeedback
+
+    feedback = desktopfeedback.DesktopFeedback(logic=None)
+    for owner, provided in (("_feedback", set(dir(feedback))), ("desktopfeedback", set(dir(desktopfeedback))),
+                            ("_drilling", set(dir(hapticdrilling.HapticDrilling(logic=None))))):
+        used = attributes_used_on(owner)
+        assert used, f"the widget uses nothing of {owner}: the check would prove nothing"
+        assert used <= provided, (owner, used - provided)
+    # The meter is drawn from the rows' keys.
+    rows = desktopfeedback.nervemonitor.meter_rows({"Nerve": {"distance_mm": 1.5, "level": "bursts", "firing_rate_hz": 10.0}})
+    source = MODULE_FILE.read_text()
+    for key in rows[0]:
+        assert f'row["{key}"]' in source or f"row['{key}']" in source, key
 
 
 # The web application needs trame-slicer: desktop Slicer does not get it, nor the benchmark area that drives it.

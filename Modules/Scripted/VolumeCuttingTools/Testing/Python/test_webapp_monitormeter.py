@@ -1,4 +1,4 @@
-"""The web application's nerve-monitor meter rows and the 3D tint by level (without a browser)."""
+"""The nerve-monitor meter rows (shown by the web application and the desktop widget) and the web 3D tint by level."""
 
 import pytest
 import slicer
@@ -13,25 +13,25 @@ def reading(distance, level):
 
 
 def test_rows_carry_the_distance_its_bar_over_0_to_8_mm_and_the_level_colour():
-    rows = monitormeter.meter_rows({"FacialNerve": reading(2.0, "bursts"), "Stapes": reading(12.5, "silent"),
+    rows = nervemonitor.meter_rows({"FacialNerve": reading(2.0, "bursts"), "Stapes": reading(12.5, "silent"),
                                     "Incus": reading(None, "not ready"), "Malleus": reading(-0.3, "contact")})
     by_name = {row["name"]: row for row in rows}
     assert by_name["FacialNerve"] == {"name": "FacialNerve", "mm": 2.0, "bar": 0.25, "level": "bursts",
                                       "colour": nervemonitor.LEVEL_COLOURS["bursts"]}
     assert by_name["Stapes"]["bar"] == 1.0  # beyond full scale: a full bar
-    assert by_name["Incus"]["mm"] is None and by_name["Incus"]["colour"] == monitormeter.NOT_READY_COLOUR
+    assert by_name["Incus"]["mm"] is None and by_name["Incus"]["colour"] == nervemonitor.NOT_READY_COLOUR
     assert by_name["Malleus"]["bar"] == 0.0
     # Before its fields are built the monitor reads 0 mm, not ready: no figure then.
-    assert monitormeter.meter_rows({"Incus": reading(0.0, "not ready")})[0]["mm"] is None
+    assert nervemonitor.meter_rows({"Incus": reading(0.0, "not ready")})[0]["mm"] is None
 
 
 def test_rows_are_sent_only_for_a_change_over_0_05_mm_or_of_level():
-    shown = monitormeter.meter_rows({"FacialNerve": reading(3.0, "sparse clicks")})
-    assert not monitormeter.rows_differ(shown, monitormeter.meter_rows({"FacialNerve": reading(3.04, "sparse clicks")}))
-    assert monitormeter.rows_differ(shown, monitormeter.meter_rows({"FacialNerve": reading(3.06, "sparse clicks")}))
-    assert monitormeter.rows_differ(shown, monitormeter.meter_rows({"FacialNerve": reading(3.0, "bursts")}))
-    assert monitormeter.rows_differ(shown, monitormeter.meter_rows({"FacialNerve": reading(None, "not ready")}))
-    assert monitormeter.rows_differ([], shown)
+    shown = nervemonitor.meter_rows({"FacialNerve": reading(3.0, "sparse clicks")})
+    assert not nervemonitor.rows_differ(shown, nervemonitor.meter_rows({"FacialNerve": reading(3.04, "sparse clicks")}))
+    assert nervemonitor.rows_differ(shown, nervemonitor.meter_rows({"FacialNerve": reading(3.06, "sparse clicks")}))
+    assert nervemonitor.rows_differ(shown, nervemonitor.meter_rows({"FacialNerve": reading(3.0, "bursts")}))
+    assert nervemonitor.rows_differ(shown, nervemonitor.meter_rows({"FacialNerve": reading(None, "not ready")}))
+    assert nervemonitor.rows_differ([], shown)
 
 
 def test_colours_convert_both_ways_and_a_bad_one_is_refused():

@@ -83,6 +83,11 @@ class HapticDrilling:
     def running(self) -> bool:
         return self.session is not None and self.session.IsRunning()
 
+    @property
+    def drilling(self) -> bool:
+        """Whether the drill runs now (the device's button or the foot switch, as the haptic loop last read it)."""
+        return self.running and bool(self.session.GetLoop().GetDrilling())
+
     def start(self, cut_node, device, renderer=None, interactor=None, foot_switch=None, falcon_firmware=None,
               device_scale: float = 1.0) -> None:
         """Start drilling ``cut_node`` with its active tool, moved by ``device`` (an InputDevice or a device_id).

@@ -31,6 +31,7 @@ LEVEL_COLOURS = {
     "continuous": "#ffab91",
     "contact": "#ef5350",
 }
+NOT_READY_COLOUR = "#9e9e9e"
 
 
 def level_name(level: int) -> str:
@@ -97,6 +98,40 @@ def nearest_mm(monitor) -> float:
     """The smallest distance (mm) from the tool's surface to a monitored structure; inf while none is ready."""
     distances = [r["distance_mm"] for r in readings(monitor).values() if r["distance_mm"] is not None] if monitor else []
     return min(distances, default=math.inf)
+
+
+# The meter the web application and the desktop widget show: a row per structure.
+FULL_SCALE_MM = 8.0  # the meter's bar spans 0-8 mm (the monitor is silent beyond its thresholds)
+DISTANCE_STEP_MM = 0.05  # a smaller change of distance is not sent to the page
+
+
+def meter_rows(current: dict) -> list[dict]:
+    """The meter's rows from :func:`readings`: name, mm (None: not ready), bar (0-1), level, colour."""
+    rows = []
+    for name, reading in current.items():
+        level = reading["level"]
+        distance = None if level == NOT_READY else reading["distance_mm"]
+        rows.append({
+            "name": name,
+            "mm": None if distance is None else round(float(distance), 2),
+            "bar": 0.0 if distance is None else round(min(max(float(distance), 0.0), FULL_SCALE_MM) / FULL_SCALE_MM, 3),
+            "level": level,
+            "colour": LEVEL_COLOURS.get(level, NOT_READY_COLOUR),
+        })
+    return rows
+
+
+def rows_differ(shown: list[dict], rows: list[dict], step_mm: float = DISTANCE_STEP_MM) -> bool:
+    """Whether ``rows`` must be sent: another structure, level or readiness, or a distance moved by > ``step_mm``."""
+    if len(shown) != len(rows):
+        return True
+    for old, new in zip(shown, rows):
+        if old["name"] != new["name"] or old["level"] != new["level"] or (old["mm"] is None) != (new["mm"] is None):
+            return True
+        if new["mm"] is not None and abs(new["mm"] - old["mm"]) > step_mm:
+            return True
+    return False
+
 
 
 def monitor_for(logic, cut_node, segment_ids=None, wait: bool = True):

@@ -20,7 +20,6 @@ is told so and may take over, nothing is lost.
 from __future__ import annotations
 
 import asyncio
-import math
 import os
 import time
 import zipfile
@@ -46,7 +45,6 @@ from wslink.websocket import LinkProtocol
 
 from ..config import toolconfig
 from ..data import headct, owndata
-from ..feedback import nervemonitor
 from ..jobs import softcutjob
 from . import monitormeter, progress, rendering, sessionrecording, soundfeed, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
@@ -210,8 +208,6 @@ class VolumeCuttingApp(TrameApp):
         self.drill.on_depth_changed = self._on_depth_changed
         self.softcut = SoftCutSession(self.session)
         self.sound = soundfeed.SoundFeed(self.session, self.state)
-        self.sound.monitor = self._monitor_for_sound
-        self.sound.nearest_structure_mm = self._nearest_structure_mm
         # The tint shows where the burr is seen: not while its glyph is hidden (off the bone, or before any pose).
         self.monitor_meter = monitormeter.MonitorMeter(self.session, self.state, tool_shown=lambda: self.drill.placed)
         self.drill.on_placed_changed = self._request_monitor_refresh
@@ -243,18 +239,6 @@ class VolumeCuttingApp(TrameApp):
         self._build_ui()
         self._connect_three_d_view()
         self.recording.watch(self._three_d_factory.areas[THREE_D_TAG])
-
-    def _nearest_structure_mm(self) -> float:
-        """The drill sound's bone ahead: the nerve monitor's nearest structure, measured at the tool's last pose."""
-        if not self.session.has_data:
-            return math.inf
-        return nervemonitor.nearest_mm(self.session.logic.GetNerveMonitor(self.session.cut_node))
-
-    def _monitor_for_sound(self) -> tuple[str, float]:
-        """The nerve monitor's clicks in the drill sound: its loudest structure (the logic updates it at every pose)."""
-        if not self.session.has_data:
-            return "silent", 0.0
-        return nervemonitor.sound_input(self.session.logic.GetNerveMonitor(self.session.cut_node))
 
     def _request_monitor_refresh(self, delay_s: float = MONITOR_REFRESH_S) -> None:
         """The meter and the tint follow the tool at most every ``delay_s``, after the pose that asked."""
@@ -451,6 +435,7 @@ class VolumeCuttingApp(TrameApp):
         self.softcut.show_skin(bool(self.state.vc_sc_skin))
         self._refresh_softcut(error="")
         self.monitor_meter.refresh(force=True)
+        self.sound.prepare()
         self._request_monitor_refresh()
         self.reset_camera()
 

@@ -1,10 +1,11 @@
 """The nerve monitor in the web application: the Drill panel's meter and the 3D tint by level.
 
 The meter is one trame state variable (``vc_monitor``), a short list of
-small rows (name, distance in mm, bar fraction over 0-8 mm, level, level
-colour). It is published only when a distance moves by more than
-``DISTANCE_STEP_MM`` or a level changes, so that a stroke costs the page a
-few small updates, not one per pose.
+small rows (``nervemonitor.meter_rows``: name, distance in mm, bar fraction
+over 0-8 mm, level, level colour; the desktop widget shows the same rows).
+It is published only when a distance moves by more than
+``nervemonitor.DISTANCE_STEP_MM`` or a level changes (``rows_differ``), so
+that a stroke costs the page a few small updates, not one per pose.
 
 The tint: the volume-cut displayable manager draws each segment in its
 segment colour (``vtkSegment::GetColor``), so a monitored segment whose level
@@ -19,38 +20,6 @@ from __future__ import annotations
 import vtk
 
 from ..feedback import nervemonitor
-
-FULL_SCALE_MM = 8.0  # the meter's bar spans 0-8 mm (the monitor is silent beyond its thresholds)
-DISTANCE_STEP_MM = 0.05  # a smaller change of distance is not sent to the page
-NOT_READY_COLOUR = "#9e9e9e"
-
-
-def meter_rows(current: dict) -> list[dict]:
-    """The meter's rows from :func:`nervemonitor.readings`: name, mm (None: not ready), bar (0-1), level, colour."""
-    rows = []
-    for name, reading in current.items():
-        level = reading["level"]
-        distance = None if level == nervemonitor.NOT_READY else reading["distance_mm"]
-        rows.append({
-            "name": name,
-            "mm": None if distance is None else round(float(distance), 2),
-            "bar": 0.0 if distance is None else round(min(max(float(distance), 0.0), FULL_SCALE_MM) / FULL_SCALE_MM, 3),
-            "level": level,
-            "colour": nervemonitor.LEVEL_COLOURS.get(level, NOT_READY_COLOUR),
-        })
-    return rows
-
-
-def rows_differ(shown: list[dict], rows: list[dict], step_mm: float = DISTANCE_STEP_MM) -> bool:
-    """Whether ``rows`` must be sent: another structure, level or readiness, or a distance moved by > ``step_mm``."""
-    if len(shown) != len(rows):
-        return True
-    for old, new in zip(shown, rows):
-        if old["name"] != new["name"] or old["level"] != new["level"] or (old["mm"] is None) != (new["mm"] is None):
-            return True
-        if new["mm"] is not None and abs(new["mm"] - old["mm"]) > step_mm:
-            return True
-    return False
 
 
 def hex_to_rgb(colour: str) -> tuple[float, float, float]:
@@ -176,8 +145,8 @@ class MonitorMeter:
             if changed:
                 # The displayable manager reads segment colours when the cut node changes: no labelmap is rebuilt.
                 self.session.cut_node.Modified()
-        rows = meter_rows(current)
-        if not force and not rows_differ(self.shown, rows):
+        rows = nervemonitor.meter_rows(current)
+        if not force and not nervemonitor.rows_differ(self.shown, rows):
             return False
         self.shown = rows
         self.state.vc_monitor = rows

@@ -1,30 +1,23 @@
-"""The drill sound's parameters for the page: published in the trame state (``vc_sound``) at 50 Hz while
+"""The drill sound's parameters for the page: published in the trame state (``vc_sound``) at 75 Hz while
 drilling, played by the page's AudioWorklet (``www/drillsound.js``).
 
-A stroke is the foot pedal: the motor spins up when it begins and down when
-it ends. Load is the removal rate (mm3/s) of the stroke, from the removed
-volume the application refreshes a few times a second (``note_removed``):
-asking the logic for it at 50 Hz would cost the server tens of ms a tick
-while the field changes. The bone ahead of the burr: the renderer
-measures wall thickness only inside its shader (vtkVolumeCutThinBoneShader,
-private to the ray caster), with no per-stroke readout, so its stand-in here
-is the nerve monitor's distance from the burr's surface to the nearest
-monitored structure (the bone left between the burr and what it must spare),
-from ``nearest_structure_mm`` (a callable; none until one is connected).
-The nerve monitor's level and rate come from ``monitor`` (a callable giving
-``(level, rate_hz)``), silent until one is connected.
+What the parameters are made of (the stroke as the foot pedal, the removal
+rate as load, the bone left ahead of the burr, the nerve monitor's clicks) is
+``feedback.soundsource.DrillSoundSource``, which the desktop plays too; this
+feed keeps them in the state on a fixed clock while a stroke is held. The
+application refreshes the removed volume a few times a second
+(``note_removed``).
 """
 
 from __future__ import annotations
 
 import asyncio
 import dataclasses
-import math
 import time
 
 from trame_server.utils.asynchronous import create_task
 
-from ..feedback import drillsound
+from ..feedback import drillsound, soundsource
 
 PERIOD_S = 1.0 / 75.0  # 75 Hz: above the 50 Hz asked for, with room for ticks a busy event loop delays
 
@@ -35,13 +28,17 @@ class SoundFeed:
     def __init__(self, session, state, config: drillsound.SoundConfig | None = None):
         self.session = session
         self.state = state
-        self.config = config or drillsound.SoundConfig()
-        self.meter = drillsound.RemovalRateMeter(window_s=0.25)
-        self.nearest_structure_mm = lambda: math.inf
-        self.monitor = lambda: ("silent", 0.0)
-        self.drill_on = False
+        self.source = soundsource.DrillSoundSource(session.logic, config)
         self._task = None
         self.published = 0
+
+    @property
+    def config(self) -> drillsound.SoundConfig:
+        return self.source.config
+
+    @property
+    def drill_on(self) -> bool:
+        return self.source.drill_on
 
     def initial_state(self) -> dict:
         return self._message(drillsound.SoundParameters())
@@ -53,20 +50,15 @@ class SoundFeed:
         """The sound's configuration for the page (``vc_sound_config``), sent once: not in every update."""
         return dataclasses.asdict(self.config)
 
-    def bone_ahead_mm(self) -> float:
-        """The stand-in for the bone left ahead: the burr's surface to the nearest monitored structure (mm)."""
-        if not self.session.has_data:
-            return math.inf
-        return max(0.0, self.nearest_structure_mm())
+    def prepare(self) -> None:
+        """New data: the bone-ahead query is made now, not at the first stroke."""
+        if self.session.has_data:
+            self.source.prepare(self.session.cut_node)
 
     def parameters(self) -> drillsound.SoundParameters:
         if not self.session.has_data:
             return drillsound.SoundParameters()
-        rate = self.meter.rate if self.drill_on else 0.0
-        level, monitor_rate = self.monitor()
-        return drillsound.parameters_from_session(
-            self.session.tool_node, self.drill_on, rate, thickness_mm=self.bone_ahead_mm(),
-            monitor_level=level, monitor_rate_hz=monitor_rate, config=self.config)
+        return self.source.parameters(self.session.cut_node, self.session.tool_node)
 
     def publish(self) -> None:
         try:
@@ -80,19 +72,16 @@ class SoundFeed:
 
     def note_removed(self, removed_mm3: float) -> None:
         """The removed volume (mm3) just refreshed: the removal rate follows from it."""
-        if self.drill_on:
-            self.meter.update(removed_mm3, time.monotonic())
+        self.source.note_removed(removed_mm3)
 
     def stroke_began(self, removed_mm3: float) -> None:
-        self.drill_on = True
-        self.meter.reset()
-        self.meter.update(removed_mm3, time.monotonic())
+        self.source.stroke_began(removed_mm3)
         self.publish()
         if self._task is None or self._task.done():
             self._task = create_task(self._tick())
 
     def stroke_ended(self) -> None:
-        self.drill_on = False
+        self.source.stroke_ended()
         self.publish()
 
     async def _tick(self) -> None:
