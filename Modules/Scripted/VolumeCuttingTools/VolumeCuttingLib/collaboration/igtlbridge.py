@@ -46,7 +46,6 @@ import selectors
 import socket
 import threading
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import slicer
@@ -55,6 +54,9 @@ from vtkmodules.util import numpy_support
 
 from ..feedback import nervemonitor
 from . import igtlprotocol as protocol
+from .igtloptions import BridgeOptions
+
+__all__ = ["BridgeOptions", "IgtlBridge"]
 
 TOOL_DEVICE = "VolumeCutTool"
 MONITOR_DEVICE = "NerveMonitor"
@@ -69,28 +71,6 @@ LOW_WATER_BYTES = 256 * 1024
 RECEIVE_CHUNK_BYTES = 65536
 # Incoming commands kept for the scene's thread; a flood beyond this loses the oldest.
 MAXIMUM_QUEUED_COMMANDS = 4096
-
-
-@dataclass
-class BridgeOptions:
-    """Where the bridge listens and how fast it streams."""
-
-    port: int = 18944  # OpenIGTLink's registered port; 0 picks a free one
-    host: str = "127.0.0.1"
-    pose_rate_hz: float = 60.0
-    monitor_rate_hz: float = 20.0
-    image_rate_hz: float = 10.0
-    max_clients: int = 8
-    stall_timeout_s: float = 2.0
-    max_backlog_bytes: int = 64 * 1024 * 1024
-    stroke_idle_s: float = 0.25
-
-    def __post_init__(self):
-        if not 0 <= int(self.port) <= 65535:
-            raise ValueError(f"OpenIGTLink port {self.port}: give 0 to 65535")
-        for name in ("pose_rate_hz", "monitor_rate_hz", "image_rate_hz"):
-            if not 1.0 <= getattr(self, name) <= 1000.0:
-                raise ValueError(f"OpenIGTLink {name.replace('_', ' ')} {getattr(self, name)}: give 1 to 1000 per second")
 
 
 class _Client:
