@@ -126,6 +126,8 @@ class IgtlBridge:
                        "accepted": collections.Counter(), "clients_connected": 0, "clients_dropped": collections.Counter(),
                        "commands_dropped": 0, "image_updates": 0, "image_update_bytes": 0}
         self.last_refusal = ""
+        # Seconds each image update took to compute on the bridge's thread (the latest ones).
+        self.image_compute_s: collections.deque = collections.deque(maxlen=1000)
         # Scene side.
         self.logic = None
         self.cut_node = None
@@ -436,13 +438,16 @@ class IgtlBridge:
                         self._receive(client)
                     if mask & selectors.EVENT_WRITE and client in self._clients:
                         self._send(client)
-            try:
-                self._produce(time.monotonic())
-            except Exception as error:  # a broken snapshot must not end the bridge
-                self.last_refusal = f"producing: {error}"
+            # Poses and readings go out before an image update is computed: they are small and wanted first.
+            for produce in (self._produce_streams, self._produce_images):
+                try:
+                    produce(time.monotonic())
+                except Exception as error:  # a broken snapshot must not end the bridge
+                    self.last_refusal = f"producing: {error}"
+                for client in list(self._clients):
+                    self._send(client)
             for client in list(self._clients):
-                self._send(client)
-                if client in self._clients and client.waiting and time.monotonic() - client.last_progress > self.options.stall_timeout_s:
+                if client.waiting and time.monotonic() - client.last_progress > self.options.stall_timeout_s:
                     self._close(client, "stalled")
 
     def _accept(self) -> None:
@@ -548,8 +553,8 @@ class IgtlBridge:
         origin = matrix[:3, 3]
         return origin.tolist(), (origin + 10.0 * matrix[:3, 2]).tolist()
 
-    def _produce(self, now: float) -> None:
-        """Put what is due into every client's queue: the latest pose and readings, image updates."""
+    def _produce_streams(self, now: float) -> None:
+        """Put what is due into every client's queue: the latest pose and readings, a new contact."""
         if not self._clients:
             return
         pose_period, monitor_period = 1.0 / self.options.pose_rate_hz, 1.0 / self.options.monitor_rate_hz
@@ -560,7 +565,6 @@ class IgtlBridge:
             monitor_seq = self._monitor_seq
             contact = self._contact if self._contact_seq != self._sent_contact_seq else None
             self._sent_contact_seq = self._contact_seq
-            geometry, geometry_seq = self._geometry, self._geometry_seq
         if pose is not None and now >= self._next_pose_at:
             self._broadcast(TOOL_DEVICE, "TRANSFORM", protocol.pack_transform(TOOL_DEVICE, np.reshape(pose[0], (4, 4)), pose[1]))
             self._sent_pose_seq = pose_seq
@@ -572,6 +576,13 @@ class IgtlBridge:
             self._next_monitor_at = now + monitor_period
         if contact is not None:
             self._broadcast(CONTACT_DEVICE, "STRING", protocol.pack_string(CONTACT_DEVICE, contact[0], contact[1]))
+
+    def _produce_images(self, now: float) -> None:
+        """The whole image to newcomers, the changed box to the others, at most ``image_rate_hz``."""
+        if not self._clients:
+            return
+        with self._lock:
+            geometry, geometry_seq = self._geometry, self._geometry_seq
         if self._image is None or self._image.seq != geometry_seq:
             self._image = _ImageMirror(geometry, geometry_seq) if geometry is not None else None
             for client in self._clients:
@@ -589,7 +600,10 @@ class IgtlBridge:
 
     def _produce_image(self) -> None:
         mirror = self._image
+        began = time.perf_counter()
         update = mirror.update()  # follows the field whoever is behind
+        if update is not None:
+            self.image_compute_s.append(time.perf_counter() - began)
         newcomers = [c for c in self._clients if c.needs_full_image]
         for client in newcomers:
             self._queue(client, mirror.pack_whole())
@@ -698,6 +712,8 @@ class _ImageMirror:
             brick_id = int(i + dims[0] * (j + dims[1] * k))
             if self.field.GetBrickStamp(brick_id):
                 self.field.AppendRemovedVoxelsOfBrick(brick_id, *removed)
+                # The interpreter's lock goes to the scene's thread between bricks: drilling there waits for one brick at most.
+                time.sleep(0)
         self._write(*removed)
         lower = bricks.min(axis=0) * step
         upper = np.minimum(bricks.max(axis=0) * step + step, size)

@@ -20,7 +20,8 @@ class BridgeOptions:
     host: str = DEFAULT_HOST
     pose_rate_hz: float = 60.0
     monitor_rate_hz: float = 20.0
-    image_rate_hz: float = 10.0
+    # Each image update recomputes the changed bricks' fractions on the bridge's thread: a few a second.
+    image_rate_hz: float = 5.0
     max_clients: int = 8
     stall_timeout_s: float = 2.0
     max_backlog_bytes: int = 64 * 1024 * 1024
