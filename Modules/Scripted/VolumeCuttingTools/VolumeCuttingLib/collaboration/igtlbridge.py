@@ -126,7 +126,7 @@ class IgtlBridge:
                        "accepted": collections.Counter(), "clients_connected": 0, "clients_dropped": collections.Counter(),
                        "commands_dropped": 0, "image_updates": 0, "image_update_bytes": 0}
         self.last_refusal = ""
-        # Seconds each image update took to compute on the bridge's thread (the latest ones).
+        # Each image update's computation on the bridge's thread (the latest ones): wall and processor seconds.
         self.image_compute_s: collections.deque = collections.deque(maxlen=1000)
         # Scene side.
         self.logic = None
@@ -600,10 +600,10 @@ class IgtlBridge:
 
     def _produce_image(self) -> None:
         mirror = self._image
-        began = time.perf_counter()
+        began, began_cpu = time.perf_counter(), time.thread_time()
         update = mirror.update()  # follows the field whoever is behind
         if update is not None:
-            self.image_compute_s.append(time.perf_counter() - began)
+            self.image_compute_s.append((time.perf_counter() - began, time.thread_time() - began_cpu))
         newcomers = [c for c in self._clients if c.needs_full_image]
         for client in newcomers:
             self._queue(client, mirror.pack_whole())
