@@ -71,6 +71,8 @@ LOW_WATER_BYTES = 256 * 1024
 RECEIVE_CHUNK_BYTES = 65536
 # Incoming commands kept for the scene's thread; a flood beyond this loses the oldest.
 MAXIMUM_QUEUED_COMMANDS = 4096
+# The bridge's thread computes an image update in slices of this many seconds, sending poses between them.
+IMAGE_SLICE_S = 0.004
 
 
 class _Client:
@@ -82,8 +84,8 @@ class _Client:
         self.received = bytearray()
         self.header: protocol.Header | None = None
         self.out = bytearray()
-        self.latest: dict[str, bytes] = {}  # coalesced: one waiting message per device
-        self.queue: collections.deque = collections.deque()  # in order: image updates
+        self.latest: dict[str, tuple] = {}  # coalesced: one waiting (type, message) per device
+        self.queue: collections.deque = collections.deque()  # in order: image updates, (type, message)
         self.queued_bytes = 0
         self.needs_full_image = True
         self.last_progress = time.monotonic()
@@ -122,6 +124,8 @@ class IgtlBridge:
         self._sent_pose_seq = self._sent_monitor_seq = self._sent_contact_seq = 0
         self._next_pose_at = self._next_monitor_at = self._next_image_at = 0.0
         self._image = None  # _ImageMirror of the attached field
+        self._image_began = (0.0, 0.0)  # when the update in progress began: wall and processor seconds
+        self._image_cpu = 0.0
         self._stats = {"sent": collections.Counter(), "sent_bytes": collections.Counter(), "refused": collections.Counter(),
                        "accepted": collections.Counter(), "clients_connected": 0, "clients_dropped": collections.Counter(),
                        "commands_dropped": 0, "image_updates": 0, "image_update_bytes": 0}
@@ -195,7 +199,8 @@ class IgtlBridge:
             return len(self._clients)
 
     def stats(self) -> dict:
-        """What went out (messages and bytes per type), what came in (accepted, refused per reason), who was dropped."""
+        """What went out (messages and bytes per type, counted as they go to a client's socket; one replaced by a later
+        pose or reading before it went is not counted), what came in (accepted, refused per reason), who was dropped."""
         with self._lock:
             return {"clients": len(self._clients), "sent": dict(self._stats["sent"]), "sent_bytes": dict(self._stats["sent_bytes"]),
                     "accepted": dict(self._stats["accepted"]), "refused": dict(self._stats["refused"]),
@@ -211,7 +216,8 @@ class IgtlBridge:
             with self._lock:
                 due = self._pose_seq != self._sent_pose_seq or self._monitor_seq != self._sent_monitor_seq or \
                     self._contact_seq != self._sent_contact_seq or any(c.waiting for c in self._clients) or \
-                    (self._image is not None and self._clients and self._image.field.GetCurrentStamp() > self._image.stamp)
+                    (self._image is not None and self._clients and
+                     (self._image.updating or self._image.field.GetCurrentStamp() > self._image.stamp))
             if not due:
                 return True
             self._wake()
@@ -418,6 +424,8 @@ class IgtlBridge:
             deadlines = [now + 0.1]
             if self._clients:
                 deadlines += [self._next_pose_at, self._next_monitor_at, self._next_image_at]
+                if self._image is not None and self._image.updating:
+                    deadlines.append(now)
             timeout = max(0.0, min(deadlines) - now)
             try:
                 events = self._selector.select(timeout)
@@ -587,32 +595,35 @@ class IgtlBridge:
             self._image = _ImageMirror(geometry, geometry_seq) if geometry is not None else None
             for client in self._clients:
                 client.needs_full_image = True
-        if self._image is not None and now >= self._next_image_at:
+        if self._image is None:
+            return
+        if not self._image.updating and now >= self._next_image_at:
             self._next_image_at = now + 1.0 / self.options.image_rate_hz
-            self._produce_image()
+            self._image_began = (time.perf_counter(), self._image_cpu)
+            self._image.begin_update()  # follows the field whoever is behind
+        if self._image.updating:
+            # A slice at a time: poses and readings go out between slices, and the scene's thread gets the interpreter.
+            began_cpu = time.thread_time()
+            box = self._image.advance(IMAGE_SLICE_S)
+            self._image_cpu += time.thread_time() - began_cpu
+            if box is not None:
+                self.image_compute_s.append((time.perf_counter() - self._image_began[0], self._image_cpu - self._image_began[1]))
+                self._send_image_box(box)
+        if not self._image.updating:
+            # Newcomers get the whole image when no update is half done.
+            for client in self._clients:
+                if client.needs_full_image:
+                    self._queue(client, self._image.pack_whole())
+                    client.needs_full_image = False
 
     def _broadcast(self, device: str, message_type: str, packed: bytes) -> None:
         for client in self._clients:
-            client.latest[device] = packed
-        with self._lock:
-            self._stats["sent"][message_type] += len(self._clients)
-            self._stats["sent_bytes"][message_type] += len(packed) * len(self._clients)
+            client.latest[device] = (message_type, packed)  # replaces one not sent yet
 
-    def _produce_image(self) -> None:
-        mirror = self._image
-        began, began_cpu = time.perf_counter(), time.thread_time()
-        update = mirror.update()  # follows the field whoever is behind
-        if update is not None:
-            self.image_compute_s.append((time.perf_counter() - began, time.thread_time() - began_cpu))
-        newcomers = [c for c in self._clients if c.needs_full_image]
-        for client in newcomers:
-            self._queue(client, mirror.pack_whole())
-            client.needs_full_image = False
-        if update is None:
-            return
-        packed = mirror.pack_box(*update)
+    def _send_image_box(self, box) -> None:
+        packed = self._image.pack_box(*box)
         for client in self._clients:
-            if client not in newcomers:
+            if not client.needs_full_image:
                 self._queue(client, packed)
         with self._lock:
             self._stats["image_updates"] += 1
@@ -625,20 +636,21 @@ class IgtlBridge:
             client.queued_bytes = 0
             client.needs_full_image = True
             return
-        client.queue.append(packed)
+        client.queue.append(("IMAGE", packed))
         client.queued_bytes += len(packed)
-        with self._lock:
-            self._stats["sent"]["IMAGE"] += 1
-            self._stats["sent_bytes"]["IMAGE"] += len(packed)
 
     def _send(self, client: _Client) -> None:
         if len(client.out) < LOW_WATER_BYTES:
-            for device in list(client.latest):
-                client.out += client.latest.pop(device)
-            while client.queue and len(client.out) < LOW_WATER_BYTES:
-                packed = client.queue.popleft()
-                client.queued_bytes -= len(packed)
-                client.out += packed
+            moved = [client.latest.pop(device) for device in list(client.latest)]
+            while client.queue and len(client.out) + sum(len(m[1]) for m in moved) < LOW_WATER_BYTES:
+                moved.append(client.queue.popleft())
+                client.queued_bytes -= len(moved[-1][1])
+            if moved:
+                with self._lock:
+                    for message_type, packed in moved:
+                        client.out += packed
+                        self._stats["sent"][message_type] += 1
+                        self._stats["sent_bytes"][message_type] += len(packed)
         if len(client.out) > self.options.max_backlog_bytes:
             self._close(client, "too slow")
             return
@@ -667,7 +679,8 @@ class _ImageMirror:
 
     Read on the bridge's thread: the field's queries are safe while its writer
     cuts. A brick's fractions read its 26 neighbours' samples, so the bricks
-    around each changed one are recomputed too.
+    around each changed one are recomputed too, a slice of bricks at a time
+    (``advance``); the image stays whole brick by brick meanwhile.
     """
 
     def __init__(self, geometry, seq: int):
@@ -677,6 +690,7 @@ class _ImageMirror:
         self.brick_dimensions = np.array(self.field.GetBrickDimensions())
         self.voxels_per_brick = max(1, 8 // self.field.GetSubVoxelFactor())
         self.stamp = self.field.GetCurrentStamp()
+        self._pending, self._box = [], None
         ids, fractions = vtk.vtkIdTypeArray(), vtk.vtkFloatArray()
         self.field.ExportRemovedVoxels(ids, fractions)
         self._write(ids, fractions)
@@ -686,38 +700,46 @@ class _ImageMirror:
             flat = self.voxels.reshape(-1)
             flat[numpy_support.vtk_to_numpy(ids)] = np.rint(np.clip(numpy_support.vtk_to_numpy(fractions), 0.0, 1.0) * 255.0)
 
-    def update(self):
-        """The box (lower, upper: i, j, k voxel indices) that changed since the last call, or None."""
+    @property
+    def updating(self) -> bool:
+        return bool(self._pending)
+
+    def begin_update(self) -> None:
+        """List the bricks to recompute: those changed since the last update and their neighbours."""
+        self._pending, self._box = [], None
         stamp = self.field.GetCurrentStamp()
         if stamp <= self.stamp:
-            return None
+            return
         changed = vtk.vtkIdList()
         self.field.GetBricksModifiedSince(self.stamp, changed)
         self.stamp = stamp
         if changed.GetNumberOfIds() == 0:
-            return None
+            return
         ids = np.array([changed.GetId(n) for n in range(changed.GetNumberOfIds())], dtype=np.int64)
         dims = self.brick_dimensions
         index = np.stack([ids % dims[0], (ids // dims[0]) % dims[1], ids // (dims[0] * dims[1])], axis=1)
         around = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)])
         bricks = np.unique((index[:, None, :] + around[None, :, :]).reshape(-1, 3), axis=0)
         bricks = bricks[np.all((bricks >= 0) & (bricks < dims), axis=1)]
-        step = self.voxels_per_brick
-        size = np.array(self.dimensions)
-        removed = vtk.vtkIdTypeArray(), vtk.vtkFloatArray()
-        for i, j, k in bricks:
+        step, size = self.voxels_per_brick, np.array(self.dimensions)
+        self._box = (bricks.min(axis=0) * step, np.minimum(bricks.max(axis=0) * step + step, size))
+        self._pending = [tuple(int(v) for v in brick) for brick in bricks]
+
+    def advance(self, budget_s: float):
+        """Recompute pending bricks for about ``budget_s``; the changed box (lower, upper: i, j, k) once all are done."""
+        deadline = time.perf_counter() + budget_s
+        dims, step, size = self.brick_dimensions, self.voxels_per_brick, np.array(self.dimensions)
+        while self._pending and time.perf_counter() < deadline:
+            i, j, k = self._pending.pop()
             lower = np.array([i, j, k]) * step
             upper = np.minimum(lower + step, size)
             self.voxels[lower[2]:upper[2], lower[1]:upper[1], lower[0]:upper[0]] = 0
-            brick_id = int(i + dims[0] * (j + dims[1] * k))
+            brick_id = i + int(dims[0]) * (j + int(dims[1]) * k)
             if self.field.GetBrickStamp(brick_id):
+                removed = vtk.vtkIdTypeArray(), vtk.vtkFloatArray()
                 self.field.AppendRemovedVoxelsOfBrick(brick_id, *removed)
-                # The interpreter's lock goes to the scene's thread between bricks: drilling there waits for one brick at most.
-                time.sleep(0)
-        self._write(*removed)
-        lower = bricks.min(axis=0) * step
-        upper = np.minimum(bricks.max(axis=0) * step + step, size)
-        return lower, upper
+                self._write(*removed)
+        return None if self._pending or self._box is None else self._box
 
     def pack_whole(self) -> bytes:
         return protocol.pack_image(IMAGE_DEVICE, self.voxels, self.dimensions, (0, 0, 0), self.ijk_to_ras, time.time())
