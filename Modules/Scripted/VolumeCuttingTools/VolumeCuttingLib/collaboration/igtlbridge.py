@@ -423,7 +423,15 @@ class IgtlBridge:
             now = time.monotonic()
             deadlines = [now + 0.1]
             if self._clients:
-                deadlines += [self._next_pose_at, self._next_monitor_at, self._next_image_at]
+                # Only what waits to go out sets a deadline: a past one with nothing to send would spin.
+                with self._lock:
+                    pose_waits = self._pose is not None and self._pose_seq != self._sent_pose_seq
+                    monitor_waits = self._monitor is not None and self._monitor_seq != self._sent_monitor_seq
+                deadlines.append(self._next_image_at)
+                if pose_waits:
+                    deadlines.append(self._next_pose_at)
+                if monitor_waits:
+                    deadlines.append(self._next_monitor_at)
                 if self._image is not None and self._image.updating:
                     deadlines.append(now)
             timeout = max(0.0, min(deadlines) - now)
@@ -595,10 +603,12 @@ class IgtlBridge:
             self._image = _ImageMirror(geometry, geometry_seq) if geometry is not None else None
             for client in self._clients:
                 client.needs_full_image = True
+        due = now >= self._next_image_at and (self._image is None or not self._image.updating)
+        if due:
+            self._next_image_at = now + 1.0 / self.options.image_rate_hz
         if self._image is None:
             return
-        if not self._image.updating and now >= self._next_image_at:
-            self._next_image_at = now + 1.0 / self.options.image_rate_hz
+        if due:
             self._image_began = (time.perf_counter(), self._image_cpu)
             self._image.begin_update()  # follows the field whoever is behind
         if self._image.updating:
