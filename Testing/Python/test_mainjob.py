@@ -134,7 +134,7 @@ def test_main_job_on_the_phantom(tmp_path):
 
     streamed = summary["openigtlink"]
     assert streamed["address"] == f"127.0.0.1:{port}" and streamed["flushed"] and not streamed["refused"]
-    assert streamed["clients_connected"] == 1 and streamed["sent"]["TRANSFORM"] > 10 and streamed["image_updates"] > 5
+    assert streamed["clients_connected"] == 1 and streamed["sent"]["TRANSFORM"] > 10 and streamed["image_updates"] >= 1
     client = clients[0]
     try:
         assert client.wait_for(lambda c: c.image is not None and c.messages("STRING", "NerveMonitor"))
