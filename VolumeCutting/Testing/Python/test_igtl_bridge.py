@@ -325,3 +325,48 @@ def test_incoming_transforms_move_the_tool_drill_a_stroke_and_set_the_guide_axis
     finally:
         client.close()
     assert bridge.stats()["accepted"] == {"TRANSFORM": 2 + len(path), "POINT": 1}
+
+
+def test_a_client_that_stops_reading_or_vanishes_is_dropped_and_the_others_keep_streaming():
+    application, logic, cut = block_scene()
+    add_burr(application.scene, cut)
+    logic.MoveActiveTool(cut, pose(-14.0), slicer.vtkSlicerVolumeCuttingLogic.ToolMove)
+    options = igtlbridge.BridgeOptions(port=0, stall_timeout_s=0.5, max_backlog_bytes=1 << 20, send_buffer_bytes=4096)
+    with igtlbridge.IgtlBridge(options) as bridge:
+        bridge.attach(logic, cut)
+        # One that never reads, with a tiny receive buffer: the bridge's sends stop going through at once.
+        silent = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        silent.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        silent.connect((HOST, bridge.port))
+        vanishing = socket.create_connection((HOST, bridge.port))
+        good = RecordingClient(HOST, bridge.port)
+        try:
+            assert good.wait_for(lambda c: c.messages("IMAGE"))
+            vanishing.close()
+            # Drilling goes on meanwhile, pose after pose.
+            began = time.monotonic()
+            assert logic.BeginStroke(cut)
+            for step in range(200):
+                logic.MoveActiveTool(cut, pose(-10.0 + 0.03 * step, 0.5 * np.sin(step / 10.0)), slicer.vtkSlicerVolumeCuttingLogic.ToolCut)
+                time.sleep(0.005)
+            logic.EndStroke(cut)
+            drilling_s = time.monotonic() - began
+            deadline = time.monotonic() + 5.0
+            while bridge.client_count() > 1 and time.monotonic() < deadline:
+                time.sleep(0.01)
+            dropped = bridge.stats()["clients_dropped"]
+            assert bridge.client_count() == 1 and dropped.get("gone") == 1, dropped
+            assert dropped.get("stalled", 0) + dropped.get("too slow", 0) == 1, dropped
+            # The good client saw it all: the last pose, the removed region as it is.
+            assert good.wait_for(lambda c: np.allclose(c.messages("TRANSFORM")[-1].message.matrix, tool_pose_of(cut), atol=1e-5))
+            assert good.wait_for(lambda c: np.array_equal(c.image[0], removed_fraction_bytes(logic, cut)))
+            assert drilling_s < 200 * 0.005 + 5.0  # never held up by the silent client
+        finally:
+            good.close()
+            silent.close()
+
+
+def tool_pose_of(cut):
+    matrix = vtk.vtkMatrix4x4()
+    cut.GetActiveToolNode().GetParentTransformNode().GetMatrixTransformToWorld(matrix)
+    return as_array(matrix)

@@ -478,6 +478,8 @@ class IgtlBridge:
             return
         connection.setblocking(False)
         connection.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        if self.options.send_buffer_bytes > 0:
+            connection.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, int(self.options.send_buffer_bytes))
         client = _Client(connection, address)
         with self._lock:
             self._clients.append(client)

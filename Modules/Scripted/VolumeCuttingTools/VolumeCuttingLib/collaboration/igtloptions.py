@@ -25,6 +25,9 @@ class BridgeOptions:
     max_clients: int = 8
     stall_timeout_s: float = 2.0
     max_backlog_bytes: int = 64 * 1024 * 1024
+    # The kernel's send buffer per client: what a client that stops reading holds before the bridge sees it stall
+    # (and what stale poses a slow one still gets); 0 leaves the system's (megabytes, on loopback).
+    send_buffer_bytes: int = 256 * 1024
     stroke_idle_s: float = 0.25
 
     def __post_init__(self):
