@@ -106,9 +106,7 @@ class IgtlBridge:
         self._thread = None
         self._selector = None
         self._listener = None
-        self._wake_out, self._wake_in = socket.socketpair()
-        self._wake_out.setblocking(False)
-        self._wake_in.setblocking(False)
+        self._wake_out = self._wake_in = None  # a socket pair that pokes the bridge's thread (while it runs)
         self._clients: list[_Client] = []
         # Snapshots the scene's thread hands over (under _lock).
         self._pose = None  # (16 floats, time)
@@ -159,6 +157,9 @@ class IgtlBridge:
             raise OSError(f"OpenIGTLink bridge cannot listen on {self.options.host}:{self.options.port}: {error}") from None
         self._listener = listener
         self.port = listener.getsockname()[1]
+        self._wake_out, self._wake_in = socket.socketpair()
+        self._wake_out.setblocking(False)
+        self._wake_in.setblocking(False)
         self._selector = selectors.DefaultSelector()
         self._selector.register(listener, selectors.EVENT_READ, "listener")
         self._selector.register(self._wake_in, selectors.EVENT_READ, "wake")
@@ -183,6 +184,10 @@ class IgtlBridge:
         if self._listener is not None:
             self._listener.close()
             self._listener = None
+        for end in (self._wake_out, self._wake_in):
+            if end is not None:
+                end.close()
+        self._wake_out = self._wake_in = None
 
     def __enter__(self):
         return self.start()
@@ -413,8 +418,11 @@ class IgtlBridge:
     # ------------------------------------------------------------------ the bridge's thread
 
     def _wake(self) -> None:
+        poke = self._wake_out
+        if poke is None:
+            return  # not started, or stopped
         try:
-            self._wake_out.send(b"\0")
+            poke.send(b"\0")
         except (BlockingIOError, OSError):
             pass  # already awake: the pipe is full of pokes
 
