@@ -1,12 +1,18 @@
 """The main job end to end: real nodes, Slicer's 3D rendering, a bundle that reloads."""
 
+import argparse
 import json
+import socket
+import threading
+import time
 
 import numpy as np
 import pytest
 import vtk
 from vtkmodules.util import numpy_support
 
+from VolumeCuttingLib.collaboration import igtloptions
+from VolumeCuttingLib.collaboration.igtlclient import RecordingClient
 from VolumeCuttingLib.jobs import mainjob
 from VolumeCuttingLib.scene.application import HeadlessSlicer
 
@@ -95,12 +101,58 @@ def check_outputs(summary, out_dir):
     assert reloaded.scene.GetFirstNodeByName(summary["exports"]["drilled_ct"]) is not None
 
 
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def connect_when_listening(port, clients, stop):
+    """Connect a recording client as soon as the job's OpenIGTLink bridge listens (as a user's Slicer would)."""
+    while not stop.is_set():
+        try:
+            clients.append(RecordingClient("127.0.0.1", port))
+            return
+        except OSError:
+            time.sleep(0.02)
+
+
 def test_main_job_on_the_phantom(tmp_path):
-    summary = mainjob.run(True, tmp_path, seed=3, size=(320, 240))
+    # Streamed over OpenIGTLink as it drills (mainjob --openigtlink PORT), to a client connected from the start.
+    port, clients, stop = free_port(), [], threading.Event()
+    connector = threading.Thread(target=connect_when_listening, args=(port, clients, stop), daemon=True)
+    connector.start()
+    try:
+        summary = mainjob.run(True, tmp_path, seed=3, size=(320, 240), openigtlink=igtloptions.BridgeOptions(port=port))
+    finally:
+        stop.set()
+        connector.join(timeout=5)
     for structure in ("FacialNerve", "SigmoidSinus", "Malleus", "Incus", "Stapes"):
         assert structure in summary["protected_segments"]
     assert "MastoidBone" in summary["cuttable_segments"]
     check_outputs(summary, tmp_path)
+
+    streamed = summary["openigtlink"]
+    assert streamed["address"] == f"127.0.0.1:{port}" and streamed["flushed"] and not streamed["refused"]
+    assert streamed["clients_connected"] == 1 and streamed["sent"]["TRANSFORM"] > 10 and streamed["image_updates"] >= 1
+    client = clients[0]
+    try:
+        assert client.wait_for(lambda c: c.image is not None and c.messages("STRING", "NerveMonitor"))
+        assert len(client.messages("TRANSFORM", "VolumeCutTool")) == streamed["sent"]["TRANSFORM"]
+        # The mirrored removed region is the job's: as many voxels touched as its exported fraction volume has.
+        assert client.error is None and client.image[0].shape == (96, 128, 128)
+        assert client.image[0].astype(float).sum() / 255.0 * 0.4 * 0.4 * 0.5 > 0.5 * summary["drilling"]["removed_volume_mm3"]
+    finally:
+        client.close()
+    # Off by default, bound to this machine unless told otherwise.
+    parser = argparse.ArgumentParser()
+    igtloptions.add_arguments(parser)
+    assert igtloptions.options_from_arguments(parser.parse_args([])) is None
+    assert igtloptions.options_from_arguments(parser.parse_args(["--openigtlink", "18944"])).host == "127.0.0.1"
+    with pytest.raises(ValueError, match="goes with --openigtlink"):
+        igtloptions.options_from_arguments(parser.parse_args(["--openigtlink-host", "0.0.0.0"]))
+    with pytest.raises(ValueError, match="0 to 65535"):
+        igtloptions.options_from_arguments(parser.parse_args(["--openigtlink", "70000"]))
 
 
 @pytest.mark.realdata

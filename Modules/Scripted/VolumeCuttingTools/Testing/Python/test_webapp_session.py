@@ -5,13 +5,18 @@ temporal-bone phantom, strokes through the logic, exports read back with
 Slicer's storage nodes. The page itself is tested in test_webapp_browser.py.
 """
 
+import argparse
+import time
 import zipfile
 
 import numpy as np
+import pyigtl
 import pytest
 import slicer
 import vtk
 
+from VolumeCuttingLib.collaboration import igtlbridge
+from VolumeCuttingLib.collaboration.igtlclient import RecordingClient
 from VolumeCuttingLib.data import owndata
 from VolumeCuttingLib.scene.application import HeadlessSlicer
 from VolumeCuttingLib.webapp import app as webapp
@@ -96,6 +101,42 @@ def test_restore_adds_bone_back_inside_the_cut(session):
     removed = session.total_removed_volume()
     stroke(session, [entry], 2.0, restore=True)
     assert session.total_removed_volume() < removed - 1.0
+
+
+def test_openigtlink_is_off_by_default_and_its_drill_poses_cut_a_stroke_of_the_session(session):
+    """``--openigtlink PORT``: a client's DrillTool poses go through the web session's strokes, as the mouse's do."""
+    parser = argparse.ArgumentParser()
+    webapp.add_arguments(parser)
+    assert webapp.options_from_arguments(parser.parse_args([])).openigtlink is None
+    options = webapp.options_from_arguments(parser.parse_args(["--openigtlink", "0"])).openigtlink
+    assert options.port == 0 and options.host == "127.0.0.1"
+    with pytest.raises(SystemExit, match="goes with --openigtlink"):
+        webapp.options_from_arguments(parser.parse_args(["--openigtlink-host", "0.0.0.0"]))
+
+    entry = lateral_point(session, y=-6.0, z=6.0)
+    undo_steps = session.undo_redo_counts()[0]
+    removed = session.total_removed_volume()
+    with igtlbridge.IgtlBridge(options) as bridge:
+        bridge.attach(session.logic, session.cut_node)
+        client = RecordingClient("127.0.0.1", bridge.port)
+        try:
+            assert client.wait_for(lambda c: c.messages("IMAGE"))
+            for i in range(8):
+                pose = tool_pose(entry + (0.0, 0.5 * i, 0.0), (-1.0, 0.0, 0.0), 2.0, session.tool_reach())
+                matrix = np.array([[pose.GetElement(r, c) for c in range(4)] for r in range(4)])
+                client.send(pyigtl.TransformMessage(matrix, device_name=igtlbridge.DRILL_DEVICE))
+            applied, deadline = {}, time.monotonic() + 5.0
+            while not applied.get("strokes_ended") and time.monotonic() < deadline:
+                for key, count in bridge.process_incoming(session).items():
+                    applied[key] = applied.get(key, 0) + count
+                time.sleep(0.005)
+            assert applied == {"drill": 8, "strokes_ended": 1}
+            assert not session.in_stroke and session.undo_redo_counts()[0] == undo_steps + 1
+            assert session.total_removed_volume() > removed + 1.0
+            assert client.wait_for(lambda c: len(c.messages("IMAGE")) > 1)  # the mirror follows the cut
+        finally:
+            client.close()
+    assert session.undo()
 
 
 def test_tool_parameters_and_presets(session):

@@ -3,6 +3,7 @@
     python -m VolumeCuttingLib.jobs.mainjob [--phantom] [--out DIR]
     python -m VolumeCuttingLib.jobs.mainjob --ct PATH [--segmentation PATH] [--color-table PATH]
                                             [--cuttable NAMES] [--protected NAMES] [--out DIR]
+    ... [--openigtlink PORT [--openigtlink-host HOST]]
 
 On the real head CT (Debian's invesalius-examples, fetched at setup), on the
 procedural temporal-bone phantom, or on the user's own CT (a DICOM series,
@@ -15,6 +16,9 @@ Slicer's displayable managers to a PNG and saves the scene as a bundle (.mrb).
 
 Later stages of the product (drilling, exact cut rendering, haptics) extend
 this job; ``summary.json`` records what each stage produced and how long it took.
+With ``--openigtlink PORT`` the drilling streams over OpenIGTLink as it goes
+(``collaboration.igtlbridge``: desktop Slicer with SlicerOpenIGTLink mirrors the
+tool, the nerve monitor, the contacts and the removed region).
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ from . import hapticsjob, selftests, softcutjob
 from ..assessment import metrics as assessment_metrics
 from ..assessment import report as assessment_report
 from ..assessment import scans as assessment_scans
+from ..collaboration import igtloptions
 from ..config import toolconfig
 from ..cutting import drilling, recording
 from ..data import headct, owndata, phantom
@@ -217,8 +222,25 @@ def session_tools(scene, plan) -> dict:
     }
 
 
-def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_data: OwnData | None = None) -> dict:
-    """Run the job; ``own_data`` (the user's CT and segmentation) takes the place of the shipped data."""
+def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_data: OwnData | None = None,
+        openigtlink: igtloptions.BridgeOptions | None = None) -> dict:
+    """Run the job; ``own_data`` (the user's CT and segmentation) takes the place of the shipped data.
+
+    ``openigtlink`` streams the session over OpenIGTLink while it runs (the bridge stops at the end).
+    """
+    bridge = None
+    if openigtlink is not None:
+        from ..collaboration import igtlbridge  # pyigtl only when asked for
+
+        bridge = igtlbridge.IgtlBridge(openigtlink).start()
+    try:
+        return _run(use_phantom, out_dir, seed, size, own_data, bridge)
+    finally:
+        if bridge is not None:
+            bridge.stop()
+
+
+def _run(use_phantom: bool, out_dir: Path, seed: int, size, own_data: OwnData | None, bridge) -> dict:
     timer = Stopwatch()
     application = HeadlessSlicer()
     logic = application.volume_cutting_logic
@@ -239,6 +261,8 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     cut_node.SetMaterialSegmentIDs(list(bone_segments))
     messages = slicer.vtkMRMLMessageCollection()
     inputs_ok = logic.CheckInputs(cut_node, messages)
+    if bridge is not None:
+        bridge.attach(logic, cut_node)
 
     # Drill a cortical mastoidectomy from the patient's right.
     if use_phantom:
@@ -312,6 +336,12 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
     with timer.measure("haptics_s"):
         haptics = hapticsjob.run(application, cut_node, plan, out_dir, frame=view.render,
                                  scan=scan_descriptor(volume, use_phantom, seed, own_data, cut_node))
+    openigtlink = None
+    if bridge is not None:
+        # Clients get what is due before the bridge closes with the job.
+        flushed = bridge.flush(timeout_s=5.0)
+        openigtlink = {"address": bridge.address, "flushed": flushed, **bridge.stats()}
+        bridge.detach()
     removed_per_segment = by_segment_name(roles, {
         segment_id: {"removed_volume_mm3": round(logic.GetRemovedVolumeInSegment(cut_node, segment_id), 2)}
         for segment_id in roles.GetSegmentIDs()
@@ -430,6 +460,7 @@ def run(use_phantom: bool, out_dir: Path, seed: int = 0, size=(1024, 768), own_d
             },
         },
         "haptics": haptics,
+        "openigtlink": openigtlink,
         "exports": {
             "removed_segmentation": removed.GetName(),
             "removed_fraction_volume": removed_fraction.GetName(),
@@ -500,7 +531,12 @@ def main(argv=None) -> int:
                           "beside the labelmap with its base name)")
     own.add_argument("--cuttable", default="", help="comma-separated names of the segments the drill may cut")
     own.add_argument("--protected", default="", help="comma-separated names of the segments the drill must not cut")
+    igtloptions.add_arguments(parser)
     args = parser.parse_args(argv)
+    try:
+        openigtlink = igtloptions.options_from_arguments(args)
+    except ValueError as error:
+        parser.error(str(error))
     own_data = None
     if args.ct is not None:
         if args.phantom:
@@ -511,7 +547,7 @@ def main(argv=None) -> int:
         parser.error("--segmentation, --color-table, --cuttable and --protected go with --ct")
     out_dir = args.out or Path("out") / ("phantom" if args.phantom else "owndata" if own_data else "headct")
     try:
-        summary = run(args.phantom, out_dir, seed=args.seed, size=args.size, own_data=own_data)
+        summary = run(args.phantom, out_dir, seed=args.seed, size=args.size, own_data=own_data, openigtlink=openigtlink)
     except owndata.InputError as error:
         print(f"main job: {error}", file=sys.stderr)
         return 1

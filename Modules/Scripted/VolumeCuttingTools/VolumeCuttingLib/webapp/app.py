@@ -2,6 +2,7 @@
 
     python -m VolumeCuttingLib.webapp [--port N] [--host H] [--phantom | --ct PATH [--segmentation PATH]]
                                       [--data-dir DIR ...] [--max-upload-mb N] [--server]
+                                      [--openigtlink PORT [--openigtlink-host HOST]]
 
 One page: a 3D view drawn by ``vtkMRMLVolumeCutDisplayableManager`` (the cut
 anatomy through the product's ray caster) and three slice views with the cut
@@ -11,6 +12,9 @@ the data, the segments and their roles, the tool, the drill, SoftCut
 measurements, STL) and the exports.
 Rendering happens here (offscreen; Mesa llvmpipe without a GPU) and trame-rca
 streams the images.
+
+With ``--openigtlink PORT`` desktop Slicer (SlicerOpenIGTLink) mirrors the
+session and may drive the tool (``collaboration.igtlbridge``).
 
 One process serves one session (one scene). More users get a process each
 through trame's launcher (see the README); a second tab on the same process
@@ -43,6 +47,7 @@ from trame_client.widgets.core import HtmlElement
 from trame_server.utils.asynchronous import create_task
 from wslink.websocket import LinkProtocol
 
+from ..collaboration import igtloptions
 from ..config import toolconfig
 from ..data import headct, owndata
 from ..jobs import softcutjob
@@ -94,6 +99,7 @@ class Options:
     refine_delay_s: float = 0.5
     work_dir: Path | None = None
     records: str | None = None
+    openigtlink: igtloptions.BridgeOptions | None = None  # off unless --openigtlink PORT
 
     @property
     def max_upload_bytes(self) -> int:
@@ -120,6 +126,7 @@ def add_arguments(parser) -> None:
     group.add_argument("--records", default=None, metavar="URL",
                        help="trainee records for the Progress panel: SQLAlchemy URL or SQLite file "
                             "(default: $VOLUMECUTTING_RECORDS or ~/.local/share/volumecutting/records.sqlite)")
+    igtloptions.add_arguments(parser)
 
 
 def options_from_arguments(args) -> Options:
@@ -135,9 +142,13 @@ def options_from_arguments(args) -> Options:
         raise SystemExit(f"--max-upload-mb {args.max_upload_mb}: give a positive size")
     data_dirs = [Path(d).expanduser().resolve() for d in args.data_dir] or [headct.default_cache_dir().resolve()]
     source = "phantom" if args.phantom else "own" if args.ct is not None else "headct"
+    try:
+        openigtlink = igtloptions.options_from_arguments(args)
+    except ValueError as error:
+        raise SystemExit(str(error)) from None
     return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
                    max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
-                   navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records)
+                   navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records, openigtlink=openigtlink)
 
 
 def path_allowed(path: Path, folders) -> bool:
@@ -239,6 +250,14 @@ class VolumeCuttingApp(TrameApp):
         self._build_ui()
         self._connect_three_d_view()
         self.recording.watch(self._three_d_factory.areas[THREE_D_TAG])
+        self.igtl = None
+        self._igtl_task = None
+        if self.options.openigtlink is not None:
+            from ..collaboration import igtlbridge  # pyigtl only when asked for
+
+            self.igtl = igtlbridge.IgtlBridge(self.options.openigtlink).start()
+            self.igtl.on_tool_driven = self._on_remote_tool
+            print(f"OpenIGTLink bridge on {self.igtl.address}", flush=True)
 
     def _request_monitor_refresh(self, delay_s: float = MONITOR_REFRESH_S) -> None:
         """The meter and the tint follow the tool at most every ``delay_s``, after the pose that asked."""
@@ -421,8 +440,40 @@ class VolumeCuttingApp(TrameApp):
         ranges = dict(toolconfig.RANGES, diameter=toolconfig.diameter_range(shape))
         return {name: [low, high] for name, (low, high) in ranges.items()}
 
+    # ------------------------------------------------------------------ OpenIGTLink
+
+    def _follow_with_openigtlink(self) -> None:
+        """The bridge streams this data's session and applies what clients send, every 10 ms on the server's loop."""
+        if self.igtl is None:
+            return
+        self.igtl.attach(self.session.logic, self.session.cut_node)
+        if self._igtl_task is None or self._igtl_task.done():
+            self._igtl_task = create_task(self._apply_openigtlink())
+
+    async def _apply_openigtlink(self) -> None:
+        while self.igtl is not None:
+            try:
+                if self.session.has_data and not self.state.vc_busy:
+                    self.igtl.process_incoming(self.session)
+            except Exception as error:  # a bad command must not stop the session
+                print(f"[openigtlink] {error}", flush=True)
+            await asyncio.sleep(0.01)
+
+    def _on_remote_tool(self, action: str) -> None:
+        """A pose from OpenIGTLink moved the tool: the views and panels follow as they do for the mouse."""
+        if action == "stroke_began":
+            self._on_stroke_begin()
+        elif action == "drilled":
+            self._on_stroke_moved()
+        elif action == "stroke_ended":
+            self._on_stroke_end()
+        else:
+            self.drill.set_glyph(placed=True)
+            self._on_hover()
+
     def _refresh_after_data(self) -> None:
         self._observe_cut_node()
+        self._follow_with_openigtlink()
         self.slicer_app.display_manager.show_volume_in_slice_background(self.session.volume)
         self.state.vc_description = self.session.description
         self.state.vc_warnings = list(self.session.warnings)
