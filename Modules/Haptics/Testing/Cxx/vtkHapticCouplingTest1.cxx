@@ -75,6 +75,15 @@ struct Hand
   double Velocity[3] = { 0, 0, 0 };
   double Work = 0.0;          ///< mJ done on the handle by the device's forces
 
+  /// The instructor's arm on its path: a 0.15 kg handle held with this stiffness and damping.
+  void Instruct(double stiffness, double damping)
+  {
+    this->Mass = 0.15;
+    this->Stiffness = stiffness;
+    this->Damping = damping;
+    this->FollowsPath = true;
+  }
+
   /// One tick under the device force held over it (semi-implicit Euler); returns the displacement.
   void Step(double time, const double deviceForce[3], double displacement[3])
   {
@@ -233,10 +242,7 @@ bool HeldCase(vtkHapticTestScene& scene)
   b.Device = vtkSmartPointer<vtkVirtualHapticDevice>::New();
   // Firm arms (2 N/mm) on both sides: in series with the coupling's spring,
   // the instructor's 20 mm excursion asks for 6.7 N.
-  a.Operator.Mass = 0.15;
-  a.Operator.Stiffness = 2.0;
-  a.Operator.Damping = 0.01;
-  a.Operator.FollowsPath = true;
+  a.Operator.Instruct(2.0, 0.01);
   b.Operator.Stiffness = 2.0;
   b.Operator.Damping = 0.01;
   if (!Configure(scene, a, 0.005, 0.1, 5, true) || !Configure(scene, b, 0.005, 0.1, 7, true) || !Link(a, b))
@@ -361,10 +367,7 @@ bool StabilityCase(vtkHapticTestScene& scene, double delay, double loss, bool pa
   }
   b.Device = vtkSmartPointer<vtkVirtualHapticDevice>::New();
   // The instructor: a firm arm (0.3 N/mm) on the path; the trainee: a relaxed hand, 3 mm off.
-  a.Operator.Mass = 0.15;
-  a.Operator.Stiffness = 0.3;
-  a.Operator.Damping = 0.004;
-  a.Operator.FollowsPath = true;
+  a.Operator.Instruct(0.3, 0.004);
   b.Operator.Position[0] = 3.0;
   b.Operator.Position[1] = -2.0;
   if (!Configure(scene, a, delay, loss, 11, passivity) || !Configure(scene, b, delay, loss, 23, passivity) || !Link(a, b))
