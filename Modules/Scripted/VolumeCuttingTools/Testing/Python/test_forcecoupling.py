@@ -60,7 +60,7 @@ def test_two_running_loops_exchange_their_proxies_over_loopback():
         device.SetPose([4.0 * index, 0.0, 0.0], 0)
         loop = slicer.vtkHapticLoop()
         loop.SetDevice(device)
-        loop.SetForceModel(forcecoupling._air_model())
+        loop.SetForceModel(forcecoupling.air_force_model())
         end = forcecoupling.ForceCoupling(forcecoupling.CouplingSettings(local_port=ports[index], peer_port=ports[1 - index]))
         end.coupling.SetEngageTime(0.0)
         end.attach(loop)

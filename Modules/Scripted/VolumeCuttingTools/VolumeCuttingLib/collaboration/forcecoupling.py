@@ -150,7 +150,7 @@ def instructor_target(time: float) -> tuple[float, float, float]:
     return (8.0 * math.sin(math.pi * time) + (12.0 if time >= 2.0 else 0.0), 4.0 * math.sin(0.5 * math.pi * time), 0.0)
 
 
-def _air_model():
+def air_force_model():
     """A force model over air only: the rehearsal's tools touch nothing but each other."""
     image = vtk.vtkImageData()
     image.SetDimensions(4, 4, 4)
@@ -183,7 +183,7 @@ def rehearse(delay_s: float, loss: float, seconds: float = 4.0, passivity: bool 
         device.GetCapabilities().SetMaximumForce(DEVICE_MAXIMUM_FORCE)
         loop = slicer.vtkHapticLoop()
         loop.SetDevice(device)
-        model = _air_model()
+        model = air_force_model()
         loop.SetForceModel(model)
         loop.SetStatisticsCapacity(max(16, int(seconds / TIME_STEP) + 16))
         end = ForceCoupling(CouplingSettings(local_port=ports[index], peer_port=ports[1 - index], injected_delay_s=delay_s,
