@@ -1,7 +1,7 @@
 """Forces forwarded from Python: settings refused with clear errors, two loops coupled on loopback.
 
 The rehearsal (two loops in lockstep with simulated hands) reproduces the C++
-test's figures: without delay the trainee tracks the instructor within 1 mm
+test's figures: without delay the trainee tracks the instructor within 0.25 mm
 RMS and the energy bound holds; with 20 ms of delay and 10 % loss the bound
 still holds and no force exceeds the device's 3.3 N; without the passivity
 layer the same delay makes the coupling active (the bound is broken), so the
@@ -87,7 +87,7 @@ def test_two_running_loops_exchange_their_proxies_over_loopback():
 
 def test_the_rehearsal_tracks_without_delay_and_stays_passive_with_delay_and_loss():
     clean = forcecoupling.rehearse(0.0, 0.0, seconds=2.0)
-    assert clean["tracking_rms_mm"] < 1.0
+    assert clean["tracking_rms_mm"] < 0.25
     assert clean["energy_bound_margin_mJ"] >= -OBSERVER_LAG_MJ
     worst = forcecoupling.rehearse(0.020, 0.1, seconds=3.0, seed=3)
     assert worst["max_force_N"] <= worst["device_force_limit_N"]
