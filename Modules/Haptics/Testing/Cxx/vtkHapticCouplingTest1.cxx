@@ -377,7 +377,7 @@ bool StabilityCase(vtkHapticTestScene& scene, double delay, double loss, bool pa
   }
   Publish(a);
   Publish(b);
-  return Run(a, b, 0.0, 4.0, figures, 0.5, 2.0);
+  return Run(a, b, 0.0, 3.0, figures, 0.5, 2.0);
 }
 } // namespace
 
