@@ -4,7 +4,6 @@
 
 #include "vtkObjectFactory.h"
 
-#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -15,6 +14,9 @@
 #include <vector>
 
 #if defined(_WIN32)
+#ifndef NOMINMAX
+#define NOMINMAX // windows.h's min and max macros would break std::min and std::max
+#endif
 #include <winsock2.h>
 #include <ws2tcpip.h>
 #else
