@@ -453,8 +453,9 @@ bool vtkHapticCouplingTransport::ReceiveLatest(double now, State& latest)
   }
   internal.WriteDue(now);
   bool received = false;
-  // Bounded: a flood cannot hold the tick; what is left waits for the next one.
-  for (int n = 0; n < 256; ++n)
+  // Bounded: a flood cannot hold the tick; what is left waits for the next
+  // one. The peer sends one a tick, so 32 leave ample room to catch up.
+  for (int n = 0; n < 32; ++n)
   {
     unsigned char buffer[512];
     sockaddr_in from{};

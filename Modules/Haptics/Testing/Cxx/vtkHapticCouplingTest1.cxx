@@ -290,7 +290,8 @@ bool HeldCase(vtkHapticTestScene& scene)
   CHECK_BOOL(probe->SendRawDatagram(packet, vtkHapticCouplingTransport::PacketSize), true);
   const double receivedBefore = b.Coupling->GetEnergyReceived();
   Figures attacked;
-  CHECK_BOOL(Run(a, b, 1.0, 0.002, attacked), true);
+  // 53 bad datagrams and the instructor's own: drained at most 32 a tick.
+  CHECK_BOOL(Run(a, b, 1.0, 0.005, attacked), true);
   double peer[3];
   CHECK_BOOL(b.Coupling->GetLatestPeerPosition(peer), true);
   double instructorProxy[3];
@@ -311,7 +312,7 @@ bool HeldCase(vtkHapticTestScene& scene)
 
   // The instructor pulls 20 mm away from the firm trainee: the spring asks for more than the device's 3.3 N.
   Figures pulled;
-  CHECK_BOOL(Run(a, b, 1.002, 1.5, pulled), true);
+  CHECK_BOOL(Run(a, b, 1.005, 1.5, pulled), true);
   std::cout << "held trainee: max force " << pulled.MaximumForce << " N, passivity margin " << pulled.WorstPassivityMargin << " mJ" << std::endl;
   CHECK_BOOL(pulled.MaximumForce <= DeviceMaximumForce + 1e-9 && pulled.MaximumForce > 0.99 * DeviceMaximumForce, true);
   CHECK_BOOL(pulled.Clamped == 0, true);
@@ -320,7 +321,7 @@ bool HeldCase(vtkHapticTestScene& scene)
   // The instructor vanishes: its last packets are in flight for the 5 ms delay, then nothing.
   const double fadeBound = b.Coupling->GetPeerTimeout() + b.Coupling->GetFadeTime();
   Figures silent;
-  CHECK_BOOL(Run(a, b, 2.502, 0.4, silent, 1e300, -1.0, false), true);
+  CHECK_BOOL(Run(a, b, 2.505, 0.4, silent, 1e300, -1.0, false), true);
   size_t lastForce = 0;
   for (size_t n = 0; n < silent.TraineeCouplingForce.size(); ++n)
   {
