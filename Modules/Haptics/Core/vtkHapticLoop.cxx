@@ -1,6 +1,7 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkHapticLoop.h"
+#include "vtkHapticCoupling.h"
 #include "vtkHapticDevice.h"
 #include "vtkHapticDeviceCapabilities.h"
 #include "vtkHapticForceModel.h"
@@ -123,6 +124,7 @@ struct vtkHapticLoop::Internals
   vtkSmartPointer<vtkVolumeCutField> Field;
   vtkSmartPointer<vtkHapticRecorder> Recorder;
   vtkSmartPointer<vtkVolumeCutNerveMonitor> Monitor;
+  vtkSmartPointer<vtkHapticCoupling> Coupling;
   vtkHapticLatestValue<NerveReadings> LatestNerve;
   double DeviceToRAS[4][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } };
   double Scale = 1.0;
@@ -318,6 +320,23 @@ vtkVolumeCutNerveMonitor* vtkHapticLoop::GetNerveMonitor()
 }
 
 //------------------------------------------------------------------------------
+void vtkHapticLoop::SetCoupling(vtkHapticCoupling* coupling)
+{
+  if (this->IsRunning())
+  {
+    vtkErrorMacro("SetCoupling: stop the loop first");
+    return;
+  }
+  this->Internal->Coupling = coupling;
+  this->Modified();
+}
+
+vtkHapticCoupling* vtkHapticLoop::GetCoupling()
+{
+  return this->Internal->Coupling;
+}
+
+//------------------------------------------------------------------------------
 int vtkHapticLoop::GetLatestNerveReadings(void* readings, int capacity) const
 {
   NerveReadings latest;
@@ -459,6 +478,15 @@ bool vtkHapticLoop::Prepare()
   {
     vtkErrorMacro("Start: the nerve monitor could not place points on the tool (see the error above)");
     return false;
+  }
+  if (internal.Coupling)
+  {
+    internal.Coupling->SetDeviceLimits(capabilities, internal.Scale);
+    if (!internal.Coupling->Prepare())
+    {
+      vtkErrorMacro("Start: the coupling to the peer could not be prepared (see the error above)");
+      return false;
+    }
   }
   if (internal.Recorder)
   {
@@ -723,8 +751,15 @@ void vtkHapticLoop::Tick(double timeStep)
   vtkHapticRecorder::Tick record{};
   record.Index = tick;
   record.Present = present;
+  const double time = static_cast<double>(tick) * timeStep;
   if (!present)
   {
+    if (internal.Coupling)
+    {
+      const double nowhere[3] = { 0.0, 0.0, 0.0 };
+      double none[3];
+      internal.Coupling->Update(time, nowhere, nowhere, false, none);
+    }
     if (internal.WasPresent)
     {
       this->SafeStop();
@@ -845,14 +880,35 @@ void vtkHapticLoop::Tick(double timeStep)
   }
   internal.LastCutValid = cut;
 
+  double total[3] = { result.Force[0], result.Force[1], result.Force[2] };
+  double coupling[3] = { 0.0, 0.0, 0.0 };
+  if (internal.Coupling)
+  {
+    // The handle in device millimetres along the scene's axes: where the
+    // coupling's force does its work, whatever the scene's scale.
+    double handle[3];
+    vtkMath::Multiply3x3(internal.MapRotation, sample.Position, handle);
+    internal.Coupling->Update(time, result.ProxyPosition, handle, true, coupling);
+    vtkMath::Add(total, coupling, total);
+  }
+
   // The force in the device's frame (forces do not scale with positions).
   double force[3];
   for (int row = 0; row < 3; ++row)
   {
-    force[row] = internal.MapRotation[0][row] * result.Force[0] + internal.MapRotation[1][row] * result.Force[1] +
-      internal.MapRotation[2][row] * result.Force[2];
+    force[row] = internal.MapRotation[0][row] * total[0] + internal.MapRotation[1][row] * total[1] +
+      internal.MapRotation[2][row] * total[2];
   }
   device->SetForce(force);
+  if (internal.Coupling)
+  {
+    // The device scales a sum above its maximum down, direction kept: so much of the coupling's force is felt.
+    const double norm = vtkMath::Norm(total);
+    const double maximum = device->GetCapabilities()->GetMaximumForce();
+    const double felt = (device->IsConnected() && std::isfinite(norm)) ? (norm > maximum ? maximum / norm : 1.0) : 0.0;
+    vtkMath::MultiplyScalar(coupling, felt);
+    internal.Coupling->ReportAppliedForce(coupling);
+  }
   double sent[3];
   device->GetCommandedForce(sent);
 

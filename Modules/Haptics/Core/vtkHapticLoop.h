@@ -60,6 +60,7 @@
 
 #include <memory> // For the internals
 
+class vtkHapticCoupling;
 class vtkHapticDevice;
 class vtkHapticForceModel;
 class vtkHapticRecorder;
@@ -105,6 +106,20 @@ public:
   void SetNerveMonitor(vtkVolumeCutNerveMonitor* monitor);
   vtkVolumeCutNerveMonitor* GetNerveMonitor();
   static constexpr int MaximumNerveReadings = 16;
+  ///@}
+
+  ///@{
+  /**
+   * Forces forwarded to and from a peer loop (vtkHapticCoupling, nullptr:
+   * none). Each tick, the coupling gets the tick's time (tick count over
+   * Rate), the proxy and the handle, and its force is added to the force
+   * model's; the share of it the device applies (the sum is scaled down to
+   * the device's maximum) is reported back to its passivity observer. While
+   * the device has no pose the peer is told so and no force is added. Set
+   * while the loop is stopped.
+   */
+  void SetCoupling(vtkHapticCoupling* coupling);
+  vtkHapticCoupling* GetCoupling();
   ///@}
 
   ///@{

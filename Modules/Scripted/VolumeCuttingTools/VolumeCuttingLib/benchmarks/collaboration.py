@@ -1,13 +1,15 @@
 """The area ``collaboration`` (issue 27): instructor and trainee together.
 
-Its parts measure each bridge out of a drilling session; so far the
-OpenIGTLink bridge to desktop Slicer (``collaborationigtl``).
+Its parts measure each bridge out of a drilling session: the OpenIGTLink
+bridge to desktop Slicer (``collaborationigtl``) and the forces forwarded
+between two haptic loops (``collaborationcoupling``).
 """
 
 from __future__ import annotations
 
+from .collaborationcoupling import coupling_measurements
 from .collaborationigtl import igtl_measurements
 
 
 def collaboration(repeats: int) -> list[dict]:
-    return igtl_measurements(repeats)
+    return igtl_measurements(repeats) + coupling_measurements(repeats)
