@@ -13,17 +13,39 @@ only when the trainee accepts, and comes back when they take it; renewing
 the link drops the instructor and the old link is refused.
 """
 
+import os
+import time
 import urllib.error
 import urllib.request
+from pathlib import Path
 
 import numpy as np
 import pytest
+from PIL import Image
 
 from VolumeCuttingLib.webapp.browser import AppPage, AppServer
 
 pytestmark = pytest.mark.browser
 
 VIEWPORT = {"width": 1280, "height": 800}
+
+
+@pytest.fixture(scope="module")
+def shots(tmp_path_factory):
+    folder = os.environ.get("VOLUMECUTTING_SCREENSHOTS")
+    path = Path(folder) if folder else tmp_path_factory.mktemp("webapp-instructor-screenshots")
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def side_by_side(left, right, path):
+    """The trainee's page (left) and the instructor's (right) in one picture, a grey band between them."""
+    images = [Image.open(left).convert("RGB"), Image.open(right).convert("RGB")]
+    band = 16
+    picture = Image.new("RGB", (sum(i.width for i in images) + band, max(i.height for i in images)), (96, 96, 96))
+    picture.paste(images[0], (0, 0))
+    picture.paste(images[1], (images[0].width + band, 0))
+    picture.save(path)
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +92,7 @@ def yellow_pixels(page):
     return int(((pixels[..., 0] > 200) & (pixels[..., 1] > 170) & (pixels[..., 2] < 90)).sum())
 
 
-def test_the_instructor_journey(server, browser, tmp_path):
-    import time
+def test_the_instructor_journey(server, browser, shots, tmp_path):
     marks = [("start", time.monotonic())]
     lap = lambda name: marks.append((name, time.monotonic()))
     trainee = open_page(browser, server.url)
@@ -114,7 +135,7 @@ def test_the_instructor_journey(server, browser, tmp_path):
     started = trainee.page.evaluate("() => Date.now()")
     stroke(trainee)
     trainee.wait_for_total_removed(f"v > {removed + 0.5}", 60)
-    trainee.wait_still(800, 60)
+    trainee.wait_still(500, 60)
     instructor.wait_for_total_removed(f"v == {trainee.total_removed()}", 20)
     area = trainee.three_d_area()
     sent = {f["st"] for f in trainee.timing()["frames"] if f["name"] == area and f["st"] > started}
@@ -126,9 +147,15 @@ def test_the_instructor_journey(server, browser, tmp_path):
     after_stroke = checksum(trainee)
     stroke(instructor)
     wait_notice(instructor, "You are watching")
-    instructor.page.evaluate("""async () => { await window.trame.trigger('vc_set_mode', ['restore']);
-        await window.trame.trigger('vc_undo'); window.trame.state.set('vc_depth', 7.5); }""")
+    instructor.page.evaluate("""async (area) => { await window.trame.trigger('vc_set_mode', ['restore']);
+        await window.trame.trigger('vc_undo'); window.trame.state.set('vc_depth', 7.5);
+        // Below the page: wslink's and trame's own calls (reload the data, stop the server, drop the frames).
+        const session = window.trame.client.getConnection().getSession();
+        await session.call('trame.lifecycle.update', ['server_ready']);
+        await session.call('application.exit.later', [1]);
+        await session.call('trame.rca.drop', [area, 0]); }""", trainee.three_d_area())
     wait_notice(instructor, "You are watching")
+    trainee.page.wait_for_timeout(1500)  # the server would stop 1 s after an exit it took
     trainee.page.wait_for_timeout(300)
     diagnostics = trainee.server_timing()
     assert diagnostics["mode"] == "drill" and state(trainee, "vc_depth") != 7.5
@@ -137,14 +164,14 @@ def test_the_instructor_journey(server, browser, tmp_path):
 
     lap('observer-refused')
     # Point: the trainee's view shows the yellow marker.
-    trainee.page.mouse.move(*point_in_view(trainee, 0.02, 0.98))
-    trainee.wait_still(800, 60)
     yellow_before = yellow_pixels(trainee)
     instructor.testid("tool-point").click()
     instructor.page.mouse.click(*point_in_view(instructor, 0.3, 0.5))
     trainee.wait_for("() => !!window.trame.state.get('vc_pointer')", 20, "the marker")
-    trainee.wait_still(800, 60)
-    assert yellow_pixels(trainee) > yellow_before + 30
+    deadline = time.monotonic() + 30
+    while yellow_pixels(trainee) <= yellow_before + 30:
+        assert time.monotonic() < deadline, "the trainee's 3D view does not show the instructor's marker"
+        trainee.page.wait_for_timeout(150)
 
     lap('point')
     # Guide axis: 6 mm into the bone where the instructor clicks; the trainee's stroke stays on it.
@@ -155,8 +182,11 @@ def test_the_instructor_journey(server, browser, tmp_path):
     guide = state(trainee, "vc_guide")
     assert guide["length"] == pytest.approx(6.0)
     assert "6.0 mm" in instructor.testid("guide-status").inner_text()
+    trainee.wait_still(500, 60)
+    instructor.page.evaluate("() => window.trame.state.set('vc_notice', '')")
+    side_by_side(trainee.screenshot(tmp_path / "trainee.png"), instructor.screenshot(tmp_path / "instructor.png"),
+                 shots / "15-instructor-link.png")
     before_guided, removed = checksum(trainee), trainee.total_removed()
-    trainee.wait_still(800, 60)
     stroke(trainee, 0.6)
     trainee.wait_for_total_removed(f"v > {removed + 0.2}", 60)
     entry, target = np.array(guide["entry"]), np.array(guide["target"])
@@ -197,9 +227,9 @@ def test_the_instructor_journey(server, browser, tmp_path):
                         "the instructor to hold control")
     instructor.set_mode("drill")
     removed = instructor.total_removed()
-    instructor.wait_still(800, 60)
     stroke(instructor, 0.4)
     instructor.wait_for_total_removed(f"v > {removed + 0.2}", 60)
+    instructor.wait_still(500, 60)  # the server has applied the whole stroke
     held = checksum(trainee)
     stroke(trainee, 0.45)
     trainee.page.wait_for_timeout(500)

@@ -32,6 +32,7 @@ AREAS = {
     "webapp": ("webapp", "webapp"),
     "records": ("records", "records"),
     "assessment": ("assessment", "assessment"),
+    "collaboration-observer": ("collaborationobserver", "observer_measurements"),
 }
 
 

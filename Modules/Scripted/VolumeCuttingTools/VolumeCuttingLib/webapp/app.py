@@ -1014,6 +1014,7 @@ class VolumeCuttingApp(TrameApp):
             self.instructor.instructor_panel()
             # The instructor's page shows what they watch (segments, drill and monitor); the rest is the trainee's.
             with Template(v_if="vc_role !== 'instructor'"):
+                self.instructor.trainee_panel()
                 self._data_panel()
             self._segments_panel()
             with Template(v_if="vc_role !== 'instructor'"):
@@ -1022,7 +1023,6 @@ class VolumeCuttingApp(TrameApp):
             with Template(v_if="vc_role !== 'instructor'"):
                 self._softcut_panel()
                 self._export_panel()
-                self.instructor.trainee_panel()
                 self.progress.build()
                 self.report.build()
 

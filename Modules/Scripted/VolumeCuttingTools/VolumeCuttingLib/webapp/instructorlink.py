@@ -9,11 +9,12 @@ them to the web server of one session:
   ``GET /instructor?key=...`` checks a link and opens the page, or answers
   403 with what to do (a guessed key, or one the trainee has renewed);
 * the gate (``bind``): every message of a page passes here before trame
-  sees it. Mouse events and view sizes, state changes and triggers apply
-  only from the page in control; an instructor page is shown everything
-  trame pushes (views, segment table, nerve monitor, the drill sound's
-  parameters) and may use its own triggers (``vc_co_*``); anything else is
-  refused and the page told why (``notify``);
+  sees it. Mouse events and view sizes, state changes, triggers and every
+  other RPC (trame-rca's frame pushes and encoder settings, wslink's exit)
+  apply only from the page in control; an instructor page is shown
+  everything trame pushes (views, segment table, nerve monitor, the drill
+  sound's parameters), reads the state and may use its own triggers
+  (``vc_co_*``); anything else is refused and the page told why (``notify``);
 * the instructor's marks in the scene (a yellow marker, the guide axis in
   cyan), seen in every page. The axis enters the bone where the instructor
   clicks and runs along the line of sight for the depth they chose; it stays
@@ -35,7 +36,7 @@ from aiohttp import web
 from trame.widgets import html
 from trame.widgets import vuetify3 as v3
 
-from ..collaboration.cosession import CoSession, CoSessionRefused
+from ..collaboration.cosession import TRAINEE, CoSession, CoSessionRefused
 from ..jobs import selftests
 from .session import balls_and_tube
 
@@ -43,6 +44,13 @@ from .session import balls_and_tube
 # takes control back from the instructor), as the co-session's own (vc_co_*) do.
 OPEN_TRIGGERS = ("vc_hello", "vc_diagnostics", "vc_take_over")
 COSESSION_PREFIX = "vc_co_"
+# wslink RPCs any joined page may call: they read, or concern the page alone.
+OPEN_RPCS = ("trame.state.get", "trame.error.client", "trame.force.push")
+# The lifecycle names trame's page sends; any other would call a controller callback of the server (on_server_ready
+# loads the data again).
+PAGE_LIFECYCLE = ("client_connected", "client_exited", "client_unmounted")
+# A page closing may end the server (wslink's application.exit*): only the trainee's page in control.
+EXIT_RPCS = ("application.exit", "application.exit.later")
 # A refused mouse press is told at most this often (a drag sends dozens of events).
 NOTICE_INTERVAL_S = 1.0
 POINTER_COLOR = (1.0, 0.85, 0.0)
@@ -81,7 +89,7 @@ class InstructorLink:
         self._handlers = []
         self._last_notice: dict[str, float] = {}
         self._marks = {}
-        self.refused = {"events": 0, "sizes": 0, "state": 0, "triggers": 0}  # for tests and benchmarks
+        self.refused = {"events": 0, "sizes": 0, "state": 0, "triggers": 0, "other": 0}  # for tests
         self.server.controller.on_server_bind.add(self.bind)
         self._bind_triggers()
 
@@ -134,15 +142,19 @@ class InstructorLink:
         """Put the gate in front of wslink's RPCs and serve the link's page."""
         web_server.app.router.add_get("/instructor", self._link_page)
         gates = {"trame.rca.event": self._gate_event, "trame.rca.size": self._gate_size,
-                 "trame.state.update": self._gate_state, "trame.trigger": self._gate_trigger}
+                 "trame.state.update": self._gate_state, "trame.trigger": self._gate_trigger,
+                 "trame.lifecycle.update": self._gate_lifecycle}
+        gates.update({uri: self._gate_open for uri in OPEN_RPCS})
+        gates.update({uri: self._gate_exit for uri in EXIT_RPCS})
         for handler in getattr(web_server, "_ws_handlers", []):
             self._handlers.append(handler)
-            for uri, gate in gates.items():
-                if uri not in handler.functionMap:
+            for uri in gates:
+                if uri not in handler.functionMap and uri not in EXIT_RPCS:
                     raise RuntimeError(f"wslink has no {uri}: the instructor link's gate needs the pinned trame")
-                protocol, function = handler.functionMap[uri]
+            for uri, (protocol, function) in list(handler.functionMap.items()):
                 if uri == "trame.rca.size":
                     self._size_call = (protocol, function)
+                gate = gates.get(uri, self._gate_controller)
                 handler.functionMap[uri] = (protocol, self._gated(handler, function, gate))
 
     @staticmethod
@@ -151,6 +163,25 @@ class InstructorLink:
             return gate(str(handler.web_app.last_active_client_id), function, args, kwargs)
 
         return call
+
+    def _gate_open(self, client, function, args, kwargs):
+        return function(*args, **kwargs) if self.cosession.may(client, "observe") else None
+
+    def _gate_controller(self, client, function, args, kwargs):
+        if self.cosession.may(client, "drive"):
+            return function(*args, **kwargs)
+        self.refused["other"] += 1
+        return None
+
+    def _gate_lifecycle(self, client, function, args, kwargs):
+        if len(args) > 1 and args[1] in PAGE_LIFECYCLE and self.cosession.may(client, "observe"):
+            return function(*args, **kwargs)
+        return None
+
+    def _gate_exit(self, client, function, args, kwargs):
+        if self.cosession.may(client, "drive") and self.cosession.role(client) == TRAINEE:
+            return function(*args, **kwargs)
+        return None
 
     def _gate_event(self, client, function, args, kwargs):
         if self.cosession.may(client, "drive"):
@@ -470,11 +501,8 @@ class InstructorLink:
                     v3.VBtn("Decline", click="trigger('vc_co_answer', [false])", raw_attrs=['data-testid="decline"'])
                     v3.VBtn("Accept", color="primary", click="trigger('vc_co_answer', [true])",
                             raw_attrs=['data-testid="accept"'])
-        with html.Div(v_if="vc_notice", raw_attrs=['data-testid="notice"'],
-                      style="position: fixed; bottom: 16px; left: 50%; transform: translateX(-50%); z-index: 3000; "
-                            "max-width: 640px;"):
-            v3.VAlert(text=("vc_notice",), type="warning", density="compact", closable=True,
-                      click_close="vc_notice = ''")
+        v3.VSnackbar(model_value=("!!vc_notice",), update_modelValue="vc_notice = $event ? vc_notice : ''", text=("vc_notice",),
+                     color="warning", timeout=8000, max_width=640, raw_attrs=['data-testid="notice"'])
 
     def toolbar_button(self) -> None:
         v3.VBtn("Take back control", v_if="vc_role === 'trainee' && vc_owner_role === 'instructor'", color="warning",
