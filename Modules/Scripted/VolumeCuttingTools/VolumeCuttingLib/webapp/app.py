@@ -18,7 +18,9 @@ session and may drive the tool (``collaboration.igtlbridge``).
 
 One process serves one session (one scene). More users get a process each
 through trame's launcher (see the README); a second tab on the same process
-is told so and may take over, nothing is lost.
+is told so and may take over, nothing is lost. An instructor joins a
+session with its own link (``instructorlink``): they watch, point, draw a
+guide axis, freeze the drill, undo, and drill when the trainee accepts.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ from trame_slicer.core import LayoutManager, SlicerApp
 from trame_slicer.rca_view.rca_view_factory import RemoteViewFactory
 from trame_slicer.views import Layout, LayoutDirection, ViewLayoutDefinition, ViewType
 from trame_client.widgets.core import HtmlElement
+from trame_client.widgets.vue import Template
 from trame_server.utils.asynchronous import create_task
 from wslink.websocket import LinkProtocol
 
@@ -51,7 +54,7 @@ from ..collaboration import igtloptions
 from ..config import toolconfig
 from ..data import headct, owndata
 from ..jobs import softcutjob
-from . import monitormeter, progress, rendering, sessionrecording, soundfeed, views
+from . import instructorlink, monitormeter, progress, rendering, sessionrecording, soundfeed, views
 from .session import (NORMAL_MODES, SOFTCUT_DEPTH_RANGE_MM, SOFTCUT_DEPTH_STEP_MM, SOFTCUT_MEASUREMENTS, DrillSession,
                       SessionError, SoftCutSession)
 
@@ -187,14 +190,17 @@ def unpack_upload(written: list[Path], folder: Path, max_bytes: int) -> Path:
 
 
 class ConnectionWatch(LinkProtocol):
-    """Tells the application when a browser tab connects or goes away (closed, reloaded, network lost)."""
+    """Tells the application when a browser tab joins with a secret (the trainee's or the instructor's)
+    or goes away (closed, reloaded, network lost)."""
 
     def __init__(self, application):
         super().__init__()
         self._application = application
 
-    def onConnect(self, request, client_id):
-        self._application.client_connected(str(client_id))
+    async def validateToken(self, token, client_id):
+        # wslink asks the link protocols instead of comparing with its own key: a page without either secret
+        # is refused here and sent nothing.
+        return self._application.instructor.validate(token, str(client_id))
 
     def onClose(self, client_id):
         self._application.client_closed(str(client_id))
@@ -230,7 +236,8 @@ class VolumeCuttingApp(TrameApp):
         slicer.vtkMRMLLayerDMPipelineFactory.GetInstance().AddPipelineCreator(self._pipeline_creator)
         self._contact_observer = None
         self._observed_cut_node = None
-        self._clients: list[str] = []
+        self.drill.stroke_refusal = lambda: self.instructor.stroke_refusal()
+        self.instructor = instructorlink.InstructorLink(self)
         self._upload_names: dict[str, str] = {}
         self._last_table_refresh = 0.0
         self._table_refresh_task = None
@@ -316,6 +323,7 @@ class VolumeCuttingApp(TrameApp):
                     raw_attrs=['data-testid="make-cuttable"'])
         html.Div("{{ vc_mode_hint }}", style="position: absolute; bottom: 8px; left: 12px; z-index: 2; color: white; "
                  "text-shadow: 0 0 3px black; pointer-events: none; font-size: 13px;")
+        self.instructor.three_d_overlay()
 
     def _create_pipeline(self, view_node, display_node):
         pipeline = self.drill.create_pipeline(view_node, display_node)
@@ -341,9 +349,9 @@ class VolumeCuttingApp(TrameApp):
         handle = adapter.on_interaction
 
         def on_interaction(origin, event):
-            # Only the tab that owns the session steers it (see client_connected).
+            # Only the page in control steers the session (the instructor link's gate drops the others' events).
             sender = self._sender()
-            if self._clients and sender and sender != self._clients[0]:
+            if sender and not self.instructor.cosession.may(sender, "drive"):
                 return
             received = time.time() * 1000.0
             handle(origin, event)
@@ -390,6 +398,14 @@ class VolumeCuttingApp(TrameApp):
                   "pixels", flush=True)
 
 
+    def _tool_centre(self):
+        transform = self.session.tool_node.GetParentTransformNode() if self.session.has_data else None
+        if transform is None:
+            return None
+        pose = vtk.vtkMatrix4x4()
+        transform.GetMatrixTransformToWorld(pose)
+        return [pose.GetElement(row, 3) for row in range(3)]
+
     def reset_camera(self) -> None:
         if self.session.has_data:
             self.three_d_view.look_from(self.session.volume_bounds(), (1.0, 0.0, 0.0))
@@ -419,7 +435,7 @@ class VolumeCuttingApp(TrameApp):
             "vc_undo_count": 0, "vc_redo_count": 0,
             "vc_contact": "", "vc_contact_fix": None, "vc_contacts": [],
             "vc_export_error": "", "vc_export_names": {},
-            "vc_owner": "", "vc_client_id": "",
+            "vc_owner": "", "vc_client_id": "", **self.instructor.initial_state(),
             "vc_sc_points": 0, "vc_sc_example": False, "vc_sc_normal": self.softcut.normal_mode,
             "vc_sc_depth": self.softcut.depth_mm, "vc_sc_previewing": False, "vc_sc_skin": False,
             "vc_sc_error": "", "vc_sc_status": "", "vc_sc_measurements": [],
@@ -432,7 +448,8 @@ class VolumeCuttingApp(TrameApp):
             # (www/monitormeter.js draws them, outside the template).
             "vc_monitor": [],
         })
-        state.client_only("vc_client_id", "vc_sound_on", "vc_sound_volume", "vc_sound_message")
+        state.client_only("vc_client_id", "vc_sound_on", "vc_sound_volume", "vc_sound_message",
+                          *instructorlink.InstructorLink.CLIENT_ONLY)
         self._update_mode_hint()
 
     @staticmethod
@@ -624,30 +641,15 @@ class VolumeCuttingApp(TrameApp):
 
     # ------------------------------------------------------------------ tabs and connections
 
-    def client_connected(self, client_id: str) -> None:
-        if client_id not in self._clients:
-            self._clients.append(client_id)
-        self._publish_owner()
-
     def client_closed(self, client_id: str) -> None:
-        was_owner = bool(self._clients) and self._clients[0] == client_id
-        if client_id in self._clients:
-            self._clients.remove(client_id)
-        if was_owner:
-            # The page went away mid-stroke (closed, reloaded, network lost): the stroke ends, the cut stays.
-            if self.drill.end_stroke():
-                self._refresh_tables()
-        self._publish_owner()
+        # A page in control that went away mid-stroke (closed, reloaded, network lost): the stroke ends, the cut stays.
+        self.instructor.left(client_id)
 
     def _sender(self) -> str:
         """The connection whose message is being handled (wslink keeps it on its web server)."""
         web_server = getattr(self.server, "_server", None)
         sender = getattr(web_server, "last_active_client_id", None)
         return str(sender) if sender is not None else ""
-
-    def _publish_owner(self) -> None:
-        with self.state:
-            self.state.vc_owner = self._clients[0] if self._clients else ""
 
     # ------------------------------------------------------------------ controller
 
@@ -656,23 +658,23 @@ class VolumeCuttingApp(TrameApp):
 
         @ctrl.trigger("vc_hello")
         def hello():
-            return self._sender()
+            return self.instructor.hello()
 
         @ctrl.trigger("vc_take_over")
         def take_over():
-            sender = self._sender()
-            self.drill.end_stroke()
-            if sender in self._clients:
-                self._clients.remove(sender)
-            self._clients.insert(0, sender)
-            self._publish_owner()
+            # A trainee tab takes control: from another tab, or back from the instructor.
+            try:
+                self.instructor.take_over(self._sender())
+            except instructorlink.CoSessionRefused as refusal:
+                self.instructor.notify(self._sender(), str(refusal))
 
         @ctrl.trigger("vc_diagnostics")
         def diagnostics():
             # For tests and benchmarks: what the server did and which mode it is in.
             return {"events": list(self.timing["events"]), "renders": list(self.timing["renders"]),
                     "frames": list(self.timing["frames"]), "ready_at": self.timing["ready_at"], "mode": self.drill.mode,
-                    "monitor": self.monitor_meter.diagnostics(), "camera_frames_recorded": self.recording.camera_frame_count}
+                    "monitor": self.monitor_meter.diagnostics(), "camera_frames_recorded": self.recording.camera_frame_count,
+                    "tool": self._tool_centre(), "refused": dict(self.instructor.refused)}
 
         @ctrl.trigger("vc_place_tool")
         def place_tool(point):
@@ -1004,11 +1006,13 @@ class VolumeCuttingApp(TrameApp):
         with SinglePageWithDrawerLayout(self.server, full_height=True) as layout:
             self.ui = layout
             layout.title.set_text("VolumeCutting")
-            client.ClientTriggers(mounted="trigger('vc_hello').then((id) => { vc_client_id = id })")
+            client.ClientTriggers(mounted=instructorlink.InstructorLink.HELLO)
             with layout.toolbar:
                 v3.VSpacer()
-                with v3.VBtnToggle(v_model=("vc_mode",), mandatory=True, density="compact", classes="mr-2",
-                                   raw_attrs=['data-testid="mode"']):
+                self.instructor.toolbar_button()
+                # The instructor's page drills (and so shows the modes) only while it holds control.
+                with v3.VBtnToggle(v_if="vc_role !== 'instructor' || vc_owner === vc_client_id", v_model=("vc_mode",),
+                                   mandatory=True, density="compact", classes="mr-2", raw_attrs=['data-testid="mode"']):
                     v3.VBtn("Navigate", value=views.MODE_NAVIGATE, click=f"trigger('vc_set_mode', ['{views.MODE_NAVIGATE}'])", prepend_icon="mdi-rotate-3d-variant", raw_attrs=['data-testid="mode-navigate"'])
                     v3.VBtn("Drill", value=views.MODE_DRILL, click=f"trigger('vc_set_mode', ['{views.MODE_DRILL}'])", prepend_icon="mdi-screw-machine-flat-top", raw_attrs=['data-testid="mode-drill"'])
                     v3.VBtn("Restore", value=views.MODE_RESTORE, click=f"trigger('vc_set_mode', ['{views.MODE_RESTORE}'])", prepend_icon="mdi-bandage", raw_attrs=['data-testid="mode-restore"'])
@@ -1024,9 +1028,13 @@ class VolumeCuttingApp(TrameApp):
                     with html.Div(style="position: absolute; inset: 0;"):
                         self.layout_manager.initialize_layout_grid(layout)
                     self._tab_overlay()
+                    self.instructor.dialogs()
 
     def _tab_overlay(self) -> None:
-        with v3.VOverlay(model_value=("vc_owner && vc_client_id && vc_owner !== vc_client_id",), persistent=True,
+        # Trainee tabs only: the instructor's page watches by design, and a trainee whose instructor holds
+        # control takes it back from the toolbar.
+        with v3.VOverlay(model_value=("vc_role === 'trainee' && vc_owner_role === 'trainee' && vc_owner && vc_client_id "
+                                      "&& vc_owner !== vc_client_id",), persistent=True,
                          contained=False, classes="align-center justify-center", raw_attrs=['data-testid="tab-overlay"']):
             with v3.VCard(max_width=520, classes="pa-4"):
                 v3.VCardTitle("This session is open in another tab")
@@ -1037,16 +1045,22 @@ class VolumeCuttingApp(TrameApp):
                     v3.VBtn("Drill from this tab", color="primary", click="trigger('vc_take_over')", raw_attrs=['data-testid="take-over"'])
 
     def _panels(self) -> None:
-        with v3.VExpansionPanels(multiple=True, model_value=("vc_panels", ["data", "segments", "tool", "drill", "softcut", "export"]),
+        with v3.VExpansionPanels(multiple=True, model_value=("vc_panels", ["instructor", "data", "segments", "tool", "drill", "softcut", "export"]),
                                  variant="accordion"):
-            self._data_panel()
+            self.instructor.instructor_panel()
+            # The instructor's page shows what they watch (segments, drill and monitor); the rest is the trainee's.
+            with Template(v_if="vc_role !== 'instructor'"):
+                self.instructor.trainee_panel()
+                self._data_panel()
             self._segments_panel()
-            self._tool_panel()
+            with Template(v_if="vc_role !== 'instructor'"):
+                self._tool_panel()
             self._drill_panel()
-            self._softcut_panel()
-            self._export_panel()
-            self.progress.build()
-            self.report.build()
+            with Template(v_if="vc_role !== 'instructor'"):
+                self._softcut_panel()
+                self._export_panel()
+                self.progress.build()
+                self.report.build()
 
     def _data_panel(self) -> None:
         with v3.VExpansionPanel(value="data", title="Data"), v3.VExpansionPanelText():
@@ -1094,6 +1108,7 @@ class VolumeCuttingApp(TrameApp):
                         with html.Td(style="padding: 0 4px; width: 112px"):
                             v3.VSelect(model_value=("s.role",), items=("vc_role_items",), density="compact",
                                        variant="plain", hide_details=True, raw_attrs=[':data-role-of="s.id"'],
+                                       disabled=("vc_role === 'instructor' && vc_owner !== vc_client_id",),
                                        style="font-size: 13px",
                                        update_modelValue="trigger('vc_set_role', [s.id, $event])")
                         html.Td("{{ s.removed.toFixed(2) }}", classes="text-right", style="padding: 0 4px",

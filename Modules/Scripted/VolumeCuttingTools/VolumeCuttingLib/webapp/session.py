@@ -766,35 +766,42 @@ class SoftCutSession:
     def outline_polydata(self) -> vtk.vtkPolyData:
         """The outline as the page draws it: a ball at each point and a tube through them (closed from 3 points)."""
         points = self.outline_points()
-        append = vtk.vtkAppendPolyData()
-        empty = vtk.vtkPolyData()
-        append.AddInputData(empty)
+        return balls_and_tube(points, ball_radius=1.2, tube_radius=0.6, closed=len(points) >= 3)
+
+
+def balls_and_tube(points, ball_radius: float, tube_radius: float, closed: bool = False) -> vtk.vtkPolyData:
+    """Marks drawn in the scene (an outline, the instructor's marker and guide axis): a ball at each point
+    (RAS, mm) and, from two points, a tube through them (back to the first when ``closed``)."""
+    append = vtk.vtkAppendPolyData()
+    append.AddInputData(vtk.vtkPolyData())
+    for point in points:
+        ball = vtk.vtkSphereSource()
+        ball.SetCenter(*point)
+        ball.SetRadius(ball_radius)
+        ball.SetThetaResolution(16)
+        ball.SetPhiResolution(12)
+        ball.Update()
+        append.AddInputData(ball.GetOutput())
+    if len(points) >= 2:
+        line = vtk.vtkPolyData()
+        vtk_points = vtk.vtkPoints()
         for point in points:
-            ball = vtk.vtkSphereSource()
-            ball.SetCenter(*point)
-            ball.SetRadius(1.2)
-            ball.Update()
-            append.AddInputData(ball.GetOutput())
-        if len(points) >= 2:
-            line = vtk.vtkPolyData()
-            vtk_points = vtk.vtkPoints()
-            for point in points:
-                vtk_points.InsertNextPoint(*point)
-            ids = list(range(len(points))) + ([0] if len(points) >= 3 else [])
-            cells = vtk.vtkCellArray()
-            cells.InsertNextCell(len(ids))
-            for index in ids:
-                cells.InsertCellPoint(index)
-            line.SetPoints(vtk_points)
-            line.SetLines(cells)
-            tube = vtk.vtkTubeFilter()
-            tube.SetInputData(line)
-            tube.SetRadius(0.6)
-            tube.SetNumberOfSides(10)
-            tube.Update()
-            append.AddInputData(tube.GetOutput())
-        append.Update()
-        return append.GetOutput()
+            vtk_points.InsertNextPoint(*point)
+        ids = list(range(len(points))) + ([0] if closed else [])
+        cells = vtk.vtkCellArray()
+        cells.InsertNextCell(len(ids))
+        for index in ids:
+            cells.InsertCellPoint(index)
+        line.SetPoints(vtk_points)
+        line.SetLines(cells)
+        tube = vtk.vtkTubeFilter()
+        tube.SetInputData(line)
+        tube.SetRadius(tube_radius)
+        tube.SetNumberOfSides(10)
+        tube.Update()
+        append.AddInputData(tube.GetOutput())
+    append.Update()
+    return append.GetOutput()
 
 
 class _ApplicationLogics:

@@ -290,6 +290,10 @@ class DrillController:
         self.on_depth_changed = lambda depth: None
         self.on_outline_pick = lambda point: None
         self.on_placed_changed = lambda: None  # the glyph shown or hidden: the tool is over the bone or not
+        # Why a stroke may not begin now (a message: the instructor froze the drill), or None.
+        self.stroke_refusal = lambda: None
+        # The instructor's guide axis (collaboration.cosession.GuideAxis): strokes follow it, or None.
+        self.guide = None
         # Where the surface under the mouse is read: the views' SurfaceDepth (the freshest is used).
         self.depth_sources = lambda: []
         # Whether the tool is over the surface (its glyph shows in every view) and touches a structure it may not cut.
@@ -482,7 +486,14 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         point, direction = hit
         camera = self.view.renderer().GetActiveCamera()
         session = self.controller.session
-        pose = tool_pose(point, direction, depth_mm, session.tool_reach(), camera.GetViewUp())
+        reach = session.tool_reach()
+        pose = tool_pose(point, direction, depth_mm, reach, camera.GetViewUp())
+        guide = self.controller.guide
+        if guide is not None:
+            # Guided drilling: the centre held on the planned path, the shaft along it; the mouse (and the
+            # bone already removed under it) says how far along.
+            centre = guide.constrain([pose.GetElement(r, 3) for r in range(3)])
+            pose = tool_pose(centre + reach * guide.direction, guide.direction, 0.0, reach, camera.GetViewUp())
         return pose, np.array([pose.GetElement(r, 3) for r in range(3)])
 
     def _on_outline_event(self, event_data) -> bool:
@@ -505,6 +516,8 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         session = self.controller.session
         source = self._depth_source()
         if source is None or source.depth is None:
+            return True
+        if self.controller.stroke_refusal() is not None:
             return True
         self._stroke_depth = source.snapshot()
         pose, center = self._pose_at(event_data, self._stroke_depth_mm(event_data))

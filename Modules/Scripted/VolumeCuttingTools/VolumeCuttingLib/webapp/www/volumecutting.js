@@ -27,5 +27,26 @@
       window.trame.trigger("vc_upload", [kind, list]);
       return "";
     },
+    // The instructor link of this session: the address of the server this page is connected to (the
+    // session's own process, also behind the launcher), with the instructor's key.
+    instructorLink(key) {
+      if (!key) {
+        return "";
+      }
+      let origin = window.location.origin;
+      const url = window.trame.client?.getConnection?.()?.getUrl?.();
+      if (url) {
+        const ws = new URL(url);
+        origin = `${ws.protocol === "wss:" ? "https:" : "http:"}//${ws.host}`;
+      }
+      return `${origin}/instructor?key=${encodeURIComponent(key)}`;
+    },
+    // [tool, fx, fy, depth]: a click on the instructor's pick layer as fractions of the 3D view's picture under
+    // it (0 at the left and bottom), which the server turns into the surface point there.
+    pickArguments(tool, event, depth) {
+      const image = document.elementsFromPoint(event.clientX, event.clientY).find((e) => e.tagName === "IMG");
+      const box = (image || event.currentTarget).getBoundingClientRect();
+      return [tool, (event.clientX - box.left) / box.width, 1 - (event.clientY - box.top) / box.height, depth];
+    },
   };
 })();
