@@ -17,7 +17,8 @@
  * and its surface iso-value, the cut field, the active tool node's shape,
  * size and burr type), places the device's workspace where the tool is
  * (DeviceScale scene millimetres per device millimetre) and starts the
- * loop; from then on the haptic thread is the cut field's only writer.
+ * loop; from then on the loop (its cutter thread, see vtkHapticLoop) is the
+ * cut field's only writer.
  *
  * Update, called by the application at display rate on the main thread,
  * is where the loop meets MRML: it reports device hot-plug, moves the

@@ -130,7 +130,7 @@ public:
   /// (bad pose or radius, no anatomy); what was cut before is kept.
   /// Each accepted cut, restore, undo or redo invokes the node's
   /// CutModifiedEvent, so call these from the thread that owns the scene; a
-  /// haptic thread cuts the vtkVolumeCutField itself (no events) and views
+  /// haptic loop cuts the vtkVolumeCutField itself (no events) and views
   /// find the changed bricks by their stamps.
   bool BeginStroke(vtkMRMLVolumeCutNode* cutNode);
   bool CutSphereSweep(vtkMRMLVolumeCutNode* cutNode, const double p0[3], const double p1[3], double radius);

@@ -28,6 +28,7 @@
 #if defined(__linux__)
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
 #endif
 #if defined(_WIN32)
 #include <windows.h>
@@ -60,6 +61,26 @@ struct Event
   double P1[3];
 };
 
+/// What a tick asks the cutter to do with the field (see Cutting in the header), in order.
+enum CutRequestTypes
+{
+  BeginStrokeRequest,
+  SegmentRequest,
+  EndStrokeRequest
+};
+
+struct CutRequest
+{
+  int Type;
+  unsigned long long Tick;
+  /// When the tick queued it (the clock's count), for the cut's latency.
+  Clock::rep Queued;
+  double P0[3];
+  double P1[3];
+  double R0[3][3];
+  double R1[3][3];
+};
+
 /// What the display reads.
 struct Display
 {
@@ -86,6 +107,33 @@ double ThreadProcessorMicroseconds()
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
   return 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
 #endif
+}
+
+/// What the system did to the calling thread so far: page faults it took
+/// (first touches of memory) and the times it took the processor from it.
+struct ThreadCounters
+{
+  long PageFaults = 0;
+  long Preemptions = 0;
+};
+
+ThreadCounters ReadThreadCounters()
+{
+  ThreadCounters counters;
+#if defined(__linux__)
+  rusage usage{};
+  if (getrusage(RUSAGE_THREAD, &usage) == 0)
+  {
+    counters.PageFaults = usage.ru_minflt + usage.ru_majflt;
+    counters.Preemptions = usage.ru_nivcsw;
+  }
+#endif
+  return counters;
+}
+
+unsigned short CountSince(long before, long after)
+{
+  return static_cast<unsigned short>(std::min(std::max(after - before, 0L), 65535L));
 }
 
 /// A hint to the processor inside a wait loop.
@@ -163,10 +211,33 @@ struct vtkHapticLoop::Internals
   std::atomic<unsigned long long> Jittered{ 0 };
   std::atomic<unsigned long long> Overruns{ 0 };
   bool RealTime = false;
-  /// Per kept tick, in the same slot as its duration: the cut stroke's time and the shield bricks it built.
+  /// Per kept tick, in the same slot as its duration: the force model's,
+  /// the cut stroke's and the nerve monitor's time, the shield bricks it
+  /// built, the page faults it took and its preemptions.
+  std::vector<float> ModelDurations;
   std::vector<float> CutDurations;
+  std::vector<float> MonitorDurations;
   std::vector<unsigned short> ShieldBuilds;
+  std::vector<unsigned short> PageFaults;
+  std::vector<unsigned short> Preemptions;
   unsigned long long ShieldBricksInTicks = 0;
+
+  // The cutter thread (see Cutting in the header).
+  std::thread Cutter;
+  std::atomic<bool> CutterStopRequested{ false };
+  /// Whether the ticks cut themselves (RunTicks, no AsynchronousCutting) or queue their cuts for the cutter.
+  bool CutInTicks = true;
+  vtkHapticRing<CutRequest> CutRequests{ 8192 };
+  /// The cutter's reports for the main thread: a ring of its own, as each ring has one producer.
+  vtkHapticRing<Event> CutterEvents{ 8192 };
+  /// The field's deepest contact as the cutter last left it, for the tick's display.
+  std::atomic<double> CutterContactDepth{ 0.0 };
+  /// A stroke's beginning or end that did not fit the queue: Stop closes the field's stroke.
+  bool StrokeRequestLost = false;
+  // Cutter's statistics, read once it has stopped.
+  std::vector<float> CutterDurations;
+  unsigned long long CutterTimed = 0;
+  float MaximumCutLatency = 0.0f;
 
   // The preparer thread (see Shield in the header).
   std::thread Preparer;
@@ -174,8 +245,96 @@ struct vtkHapticLoop::Internals
   /// The tool's reach around its pose (mm), set by Prepare.
   double ToolReach = 0.0;
 
+  /// Haptic thread: keep a tick's times and what the system did meanwhile in its slot.
+  void KeepTick(float duration, float processorTime, const ThreadCounters& before, const ThreadCounters& after)
+  {
+    const unsigned long long timed = this->Timed.load(std::memory_order_relaxed);
+    const size_t slot = timed % this->Durations.size();
+    this->Durations[slot] = duration;
+    this->ProcessorDurations[slot] = processorTime;
+    this->PageFaults[slot] = CountSince(before.PageFaults, after.PageFaults);
+    this->Preemptions[slot] = CountSince(before.Preemptions, after.Preemptions);
+    this->Timed.store(timed + 1, std::memory_order_release);
+  }
+
   /// Haptic thread: a report for the main thread (counted, not kept, when the ring is full).
   void Push(unsigned long long tick, int type, const double p0[3] = nullptr, const double p1[3] = nullptr)
+  {
+    this->PushTo(this->Events, tick, type, p0, p1);
+  }
+
+  /// The writer's thread: cut the tool's sweep from pose 0 to pose 1 (centres and rotations).
+  bool CutSegment(const double p0[3], const double p1[3], const double r0[3][3], const double r1[3][3])
+  {
+    if (!this->Tool)
+    {
+      return this->Field->CutCapsule(p0, p1, this->Radius);
+    }
+    for (int row = 0; row < 3; ++row)
+    {
+      for (int column = 0; column < 3; ++column)
+      {
+        this->Pose0->SetElement(row, column, r0[row][column]);
+        this->Pose1->SetElement(row, column, r1[row][column]);
+      }
+      this->Pose0->SetElement(row, 3, p0[row]);
+      this->Pose1->SetElement(row, 3, p1[row]);
+    }
+    return this->Field->CutToolSweep(this->Tool, this->Pose0, this->Pose1);
+  }
+
+  /// Haptic thread: queue a request for the cutter; false if the queue is full (the cutter is far behind).
+  bool QueueCut(int type, unsigned long long tick, const double p0[3] = nullptr, const double p1[3] = nullptr,
+    const double r0[3][3] = nullptr, const double r1[3][3] = nullptr)
+  {
+    CutRequest request{};
+    request.Type = type;
+    request.Tick = tick;
+    request.Queued = Clock::now().time_since_epoch().count();
+    if (p0 && p1 && r0 && r1)
+    {
+      std::copy(p0, p0 + 3, request.P0);
+      std::copy(p1, p1 + 3, request.P1);
+      std::copy(&r0[0][0], &r0[0][0] + 9, &request.R0[0][0]);
+      std::copy(&r1[0][0], &r1[0][0] + 9, &request.R1[0][0]);
+    }
+    return this->CutRequests.Push(request);
+  }
+
+  /// Haptic thread: the drill starts or stops, in the tick or through the cutter.
+  void ChangeStroke(unsigned long long tick, bool open)
+  {
+    if (this->CutInTicks)
+    {
+      open ? this->Field->BeginStroke() : this->Field->EndStroke();
+    }
+    else if (!this->QueueCut(open ? BeginStrokeRequest : EndStrokeRequest, tick))
+    {
+      this->StrokeRequestLost = true;
+      this->DroppedEvents.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+
+  /// Cutter thread: carry out one request of the ticks.
+  void ApplyCutRequest(const CutRequest& request)
+  {
+    if (request.Type != SegmentRequest)
+    {
+      request.Type == BeginStrokeRequest ? this->Field->BeginStroke() : this->Field->EndStroke();
+      return;
+    }
+    const Clock::time_point start = Clock::now();
+    const bool cut = this->CutSegment(request.P0, request.P1, request.R0, request.R1);
+    const Clock::time_point end = Clock::now();
+    this->CutterDurations[this->CutterTimed % this->CutterDurations.size()] = std::chrono::duration<float, std::micro>(end - start).count();
+    ++this->CutterTimed;
+    const Clock::time_point queued{ Clock::duration(request.Queued) };
+    this->MaximumCutLatency = std::max(this->MaximumCutLatency, std::chrono::duration<float, std::micro>(end - queued).count());
+    this->CutterContactDepth.store(this->Field->GetMaximumContactDepth(), std::memory_order_relaxed);
+    this->PushTo(this->CutterEvents, request.Tick, cut ? CutEvent : FailedCutEvent, request.P0, request.P1);
+  }
+
+  void PushTo(vtkHapticRing<Event>& ring, unsigned long long tick, int type, const double p0[3], const double p1[3])
   {
     Event event{};
     event.Tick = tick;
@@ -188,7 +347,7 @@ struct vtkHapticLoop::Internals
     {
       std::copy(p1, p1 + 3, event.P1);
     }
-    if (!this->Events.Push(event))
+    if (!ring.Push(event))
     {
       this->DroppedEvents.fetch_add(1, std::memory_order_relaxed);
     }
@@ -496,9 +655,20 @@ bool vtkHapticLoop::Prepare()
   internal.Durations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.ProcessorDurations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
   internal.Jitters.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
-  internal.CutDurations.assign(static_cast<size_t>(this->StatisticsCapacity), 0.0f);
-  internal.ShieldBuilds.assign(static_cast<size_t>(this->StatisticsCapacity), 0);
+  const size_t capacity = static_cast<size_t>(this->StatisticsCapacity);
+  internal.ModelDurations.assign(capacity, 0.0f);
+  internal.CutDurations.assign(capacity, 0.0f);
+  internal.MonitorDurations.assign(capacity, 0.0f);
+  internal.ShieldBuilds.assign(capacity, 0);
+  internal.PageFaults.assign(capacity, 0);
+  internal.Preemptions.assign(capacity, 0);
   internal.ShieldBricksInTicks = 0;
+  internal.CutterDurations.assign(capacity, 0.0f);
+  internal.CutterTimed = 0;
+  internal.MaximumCutLatency = 0.0f;
+  internal.CutInTicks = true;
+  internal.StrokeRequestLost = false;
+  internal.CutterContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
   internal.Timed = 0;
   internal.Jittered = 0;
   internal.Overruns = 0;
@@ -511,7 +681,11 @@ bool vtkHapticLoop::Prepare()
   this->NumberOfDeviceReturns = this->NumberOfFailedCuts = this->NumberOfDroppedEvents = 0;
   internal.DroppedEvents = 0;
   Event stale;
-  while (internal.Events.Pop(stale))
+  while (internal.Events.Pop(stale) || internal.CutterEvents.Pop(stale))
+  {
+  }
+  CutRequest unused;
+  while (internal.CutRequests.Pop(unused))
   {
   }
   internal.Prepared = true;
@@ -533,6 +707,12 @@ bool vtkHapticLoop::Start()
   internal.StopRequested = false;
   internal.RealTime = false;
   internal.Running = true;
+  internal.CutInTicks = !(this->AsynchronousCutting && internal.Field);
+  if (!internal.CutInTicks)
+  {
+    internal.CutterStopRequested = false;
+    internal.Cutter = std::thread([this]() { this->CutQueuedSegments(); });
+  }
   internal.Thread = std::thread([this]() { this->Run(); });
   if (this->PrepareShieldAhead && internal.Field && internal.Field->GetProtection()->HasShieldedLabels())
   {
@@ -546,6 +726,15 @@ bool vtkHapticLoop::Start()
   sched_param parameters{};
   parameters.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
   internal.RealTime = pthread_setschedparam(internal.Thread.native_handle(), SCHED_FIFO, &parameters) == 0;
+  if (internal.Cutter.joinable())
+  {
+    // Just below the haptic thread, above everything else: the force reads
+    // the field as the cutter left it, so the cut must not wait for the
+    // machine's other work (its work is bounded: what the ticks queue).
+    sched_param cutter{};
+    cutter.sched_priority = std::max(sched_get_priority_min(SCHED_FIFO), parameters.sched_priority - 1);
+    pthread_setschedparam(internal.Cutter.native_handle(), SCHED_FIFO, &cutter);
+  }
   if (this->ProcessorIndex >= 0 && this->ProcessorIndex < CPU_SETSIZE)
   {
     cpu_set_t set;
@@ -575,6 +764,16 @@ void vtkHapticLoop::Stop()
   {
     this->Finish();
   }
+  // The haptic thread has queued its last cuts (and the stroke's end): the cutter cuts them all, then stops.
+  if (internal.Cutter.joinable())
+  {
+    internal.CutterStopRequested = true;
+    internal.Cutter.join();
+    if (internal.StrokeRequestLost && internal.Field->IsStrokeOpen())
+    {
+      internal.Field->EndStroke();
+    }
+  }
   internal.Running = false;
   internal.Prepared = false;
 }
@@ -596,12 +795,13 @@ bool vtkHapticLoop::RunTicks(int count)
   for (int n = 0; n < count; ++n)
   {
     const Clock::time_point start = Clock::now();
+    const ThreadCounters countersBefore = ReadThreadCounters();
     const double processorStart = ThreadProcessorMicroseconds();
     this->Tick(timeStep);
-    const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
-    internal.Durations[timed % internal.Durations.size()] = std::chrono::duration<float, std::micro>(Clock::now() - start).count();
-    internal.ProcessorDurations[timed % internal.Durations.size()] = static_cast<float>(ThreadProcessorMicroseconds() - processorStart);
-    internal.Timed.store(timed + 1, std::memory_order_release);
+    const double processorEnd = ThreadProcessorMicroseconds();
+    const ThreadCounters countersAfter = ReadThreadCounters();
+    internal.KeepTick(std::chrono::duration<float, std::micro>(Clock::now() - start).count(),
+      static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
   }
   return true;
 }
@@ -641,14 +841,14 @@ void vtkHapticLoop::Run()
     hasPrevious = true;
     // The processor time is read inside the wall-clock interval, so that a
     // tick's processor time never exceeds its wall time.
+    const ThreadCounters countersBefore = ReadThreadCounters();
     const double processorStart = ThreadProcessorMicroseconds();
     this->Tick(timeStep);
     const double processorEnd = ThreadProcessorMicroseconds();
+    const ThreadCounters countersAfter = ReadThreadCounters();
     const Clock::time_point end = Clock::now();
-    const unsigned long long timed = internal.Timed.load(std::memory_order_relaxed);
-    internal.Durations[timed % capacity] = std::chrono::duration<float, std::micro>(end - start).count();
-    internal.ProcessorDurations[timed % capacity] = static_cast<float>(processorEnd - processorStart);
-    internal.Timed.store(timed + 1, std::memory_order_release);
+    internal.KeepTick(
+      std::chrono::duration<float, std::micro>(end - start).count(), static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
     deadline += period;
     if (end > deadline)
     {
@@ -690,6 +890,33 @@ void vtkHapticLoop::PrepareShield()
 }
 
 //------------------------------------------------------------------------------
+void vtkHapticLoop::CutQueuedSegments()
+{
+  Internals& internal = *this->Internal;
+  for (;;)
+  {
+    // Read before draining: whatever the ticks queued before the stop request is cut too.
+    const bool stopping = internal.CutterStopRequested.load(std::memory_order_acquire);
+    bool cutAny = false;
+    CutRequest request;
+    while (internal.CutRequests.Pop(request))
+    {
+      internal.ApplyCutRequest(request);
+      cutAny = true;
+    }
+    if (stopping)
+    {
+      return;
+    }
+    if (!cutAny)
+    {
+      // A fraction of a tick: the cut follows the tick that queued it closely.
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  }
+}
+
+//------------------------------------------------------------------------------
 void vtkHapticLoop::SafeStop()
 {
   Internals& internal = *this->Internal;
@@ -697,7 +924,7 @@ void vtkHapticLoop::SafeStop()
   if (internal.StrokeOpen && internal.Field)
   {
     // Everything cut so far stays, as one undo step.
-    internal.Field->EndStroke();
+    internal.ChangeStroke(tick, false);
     internal.Push(tick, DrillReleaseEvent);
   }
   internal.StrokeOpen = false;
@@ -729,7 +956,9 @@ void vtkHapticLoop::Tick(double timeStep)
   internal.TickCount.store(tick + 1, std::memory_order_release);
   // This tick's slot in the statistics: the one its duration goes to.
   const size_t slot = internal.Timed.load(std::memory_order_relaxed) % internal.Durations.size();
+  internal.ModelDurations[slot] = 0.0f;
   internal.CutDurations[slot] = 0.0f;
+  internal.MonitorDurations[slot] = 0.0f;
   internal.ShieldBuilds[slot] = 0;
   vtkHapticDevice* device = internal.Device;
   device->Synchronize(tick);
@@ -817,28 +1046,20 @@ void vtkHapticLoop::Tick(double timeStep)
   const bool drilling = internal.Field && ((sample.Buttons | switchButtons) & this->DrillButtons) != 0;
   if (drilling != internal.StrokeOpen)
   {
-    if (drilling)
-    {
-      internal.Field->BeginStroke();
-      internal.Push(tick, DrillPressEvent);
-    }
-    else
-    {
-      internal.Field->EndStroke();
-      internal.Push(tick, DrillReleaseEvent);
-    }
+    internal.ChangeStroke(tick, drilling);
+    internal.Push(tick, drilling ? DrillPressEvent : DrillReleaseEvent);
     internal.StrokeOpen = drilling;
     internal.LastCutValid = false;
   }
 
   vtkHapticForceModel::Result result;
+  const Clock::time_point modelStart = Clock::now();
   internal.Model->Update(position, rotation, timeStep, drilling, result);
+  internal.ModelDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - modelStart).count();
 
   bool cut = false;
   if (drilling && result.Cut)
   {
-    vtkVolumeCutProtection* protection = internal.Field->GetProtection();
-    const vtkIdType shieldBefore = protection->GetNumberOfBricksBuiltOnDemand();
     const Clock::time_point cutStart = Clock::now();
     const double* p1 = result.CutPosition;
     const double* p0 = internal.LastCutValid ? internal.LastCut : p1;
@@ -848,30 +1069,27 @@ void vtkHapticLoop::Tick(double timeStep)
     {
       p0 = p1;
     }
-    if (internal.Tool)
+    const double (*r0)[3] = internal.LastCutValid ? internal.LastCutRotation : rotation;
+    if (internal.CutInTicks)
     {
-      const double (*r0)[3] = internal.LastCutValid ? internal.LastCutRotation : rotation;
-      for (int row = 0; row < 3; ++row)
-      {
-        for (int column = 0; column < 3; ++column)
-        {
-          internal.Pose0->SetElement(row, column, r0[row][column]);
-          internal.Pose1->SetElement(row, column, rotation[row][column]);
-        }
-        internal.Pose0->SetElement(row, 3, p0[row]);
-        internal.Pose1->SetElement(row, 3, p1[row]);
-      }
-      cut = internal.Field->CutToolSweep(internal.Tool, internal.Pose0, internal.Pose1);
+      vtkVolumeCutProtection* protection = internal.Field->GetProtection();
+      const vtkIdType shieldBefore = protection->GetNumberOfBricksBuiltOnDemand();
+      cut = internal.CutSegment(p0, p1, r0, rotation);
+      const vtkIdType shieldBuilt = protection->GetNumberOfBricksBuiltOnDemand() - shieldBefore;
+      internal.ShieldBuilds[slot] = static_cast<unsigned short>(std::min<vtkIdType>(std::max<vtkIdType>(shieldBuilt, 0), 65535));
+      internal.ShieldBricksInTicks += static_cast<unsigned long long>(std::max<vtkIdType>(shieldBuilt, 0));
+      internal.Push(tick, cut ? CutEvent : FailedCutEvent, p0, p1);
     }
     else
     {
-      cut = internal.Field->CutCapsule(p0, p1, internal.Radius);
+      // The cutter reports the cut; a full queue (a cutter far behind) loses this segment, told as a failed cut.
+      cut = internal.QueueCut(SegmentRequest, tick, p0, p1, r0, rotation);
+      if (!cut)
+      {
+        internal.Push(tick, FailedCutEvent, p0, p1);
+      }
     }
     internal.CutDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - cutStart).count();
-    const vtkIdType shieldBuilt = protection->GetNumberOfBricksBuiltOnDemand() - shieldBefore;
-    internal.ShieldBuilds[slot] = static_cast<unsigned short>(std::min<vtkIdType>(std::max<vtkIdType>(shieldBuilt, 0), 65535));
-    internal.ShieldBricksInTicks += static_cast<unsigned long long>(std::max<vtkIdType>(shieldBuilt, 0));
-    internal.Push(tick, cut ? CutEvent : FailedCutEvent, p0, p1);
     if (cut)
     {
       std::copy(p1, p1 + 3, internal.LastCut);
@@ -925,16 +1143,20 @@ void vtkHapticLoop::Tick(double timeStep)
   display.ToolToRAS[15] = 1.0;
   std::copy(sent, sent + 3, display.Force);
   display.Drilling = drilling ? 1 : 0;
-  display.ContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
+  display.ContactDepth = !internal.Field ? 0.0
+    : internal.CutInTicks               ? internal.Field->GetMaximumContactDepth()
+                                        : internal.CutterContactDepth.load(std::memory_order_relaxed);
   internal.Latest.Store(display);
 
   if (internal.Monitor)
   {
+    const Clock::time_point monitorStart = Clock::now();
     NerveReadings readings;
     readings.Count = internal.Tool ? internal.Monitor->MeasureTool(display.ToolToRAS, readings.Values, MaximumNerveReadings)
                                    : internal.Monitor->Measure(result.ProxyPosition, internal.Radius, readings.Values, MaximumNerveReadings);
     readings.Count = std::min(readings.Count, static_cast<int>(MaximumNerveReadings));
     internal.LatestNerve.Store(readings);
+    internal.MonitorDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - monitorStart).count();
   }
 
   if (internal.Recorder)
@@ -993,7 +1215,7 @@ int vtkHapticLoop::ProcessEvents()
   Internals& internal = *this->Internal;
   int cuts = 0;
   Event event;
-  while (internal.Events.Pop(event))
+  while (internal.Events.Pop(event) || internal.CutterEvents.Pop(event))
   {
     switch (event.Type)
     {
@@ -1126,6 +1348,51 @@ double vtkHapticLoop::GetMaximumTickDurationBuildingShield() const
 }
 
 //------------------------------------------------------------------------------
+double vtkHapticLoop::GetCutterDurationPercentile(double percent) const
+{
+  const Internals& internal = *this->Internal;
+  const size_t count = std::min<size_t>(internal.CutterTimed, internal.CutterDurations.size());
+  return Percentile(std::vector<float>(internal.CutterDurations.begin(), internal.CutterDurations.begin() + count), percent);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetMaximumCutLatency() const
+{
+  return this->Internal->MaximumCutLatency;
+}
+
+//------------------------------------------------------------------------------
+int vtkHapticLoop::GetNumberOfKeptTicks() const
+{
+  const Internals& internal = *this->Internal;
+  return static_cast<int>(std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.Durations.size()));
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticLoop::GetTickProfile(int index, double profile[8]) const
+{
+  static_assert(NumberOfTickProfileFields == 8, "the profile's array holds every field");
+  const Internals& internal = *this->Internal;
+  if (index < 0 || index >= this->GetNumberOfKeptTicks())
+  {
+    return false;
+  }
+  // Once the statistics have wrapped around, the oldest kept tick is in the slot after the newest.
+  const unsigned long long timed = internal.Timed.load(std::memory_order_acquire);
+  const size_t capacity = internal.Durations.size();
+  const size_t slot = timed > capacity ? (timed + static_cast<unsigned long long>(index)) % capacity : static_cast<size_t>(index);
+  profile[ProfileDuration] = internal.Durations[slot];
+  profile[ProfileProcessorTime] = internal.ProcessorDurations[slot];
+  profile[ProfileForceModel] = internal.ModelDurations[slot];
+  profile[ProfileCut] = internal.CutDurations[slot];
+  profile[ProfileNerveMonitor] = internal.MonitorDurations[slot];
+  profile[ProfileShieldBricksBuilt] = internal.ShieldBuilds[slot];
+  profile[ProfilePageFaults] = internal.PageFaults[slot];
+  profile[ProfilePreemptions] = internal.Preemptions[slot];
+  return true;
+}
+
+//------------------------------------------------------------------------------
 bool vtkHapticLoop::GetRealTimePriority() const
 {
   return this->Internal->RealTime;
@@ -1159,5 +1426,6 @@ void vtkHapticLoop::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "NumberOfCutStrokes: " << this->NumberOfCutStrokes << "\n";
   os << indent << "PrepareShieldAhead: " << (this->PrepareShieldAhead ? "on" : "off") << "\n";
   os << indent << "ShieldLookAhead: " << this->ShieldLookAhead << " mm\n";
+  os << indent << "AsynchronousCutting: " << (this->AsynchronousCutting ? "on" : "off") << "\n";
   os << indent << "DeviceScale: " << this->GetDeviceScale() << "\n";
 }

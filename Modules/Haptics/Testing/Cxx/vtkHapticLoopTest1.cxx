@@ -213,6 +213,28 @@ int vtkHapticLoopTest1(int argc, char* argv[])
   const int recorded = recorder->GetNumberOfTicks();
   CHECK_INT(recorded, static_cast<int>(loop->GetNumberOfTicks()));
 
+  // Each tick's profile: its parts, timed inside it on the same clock, fit
+  // in its wall time; ticks that drilled spent time cutting (RunTicks cuts
+  // in the tick: the cutter has cut nothing).
+  CHECK_INT(loop->GetNumberOfKeptTicks(), recorded);
+  double profile[vtkHapticLoop::NumberOfTickProfileFields];
+  int cuttingTicks = 0;
+  int overfull = 0;
+  for (int n = 0; n < loop->GetNumberOfKeptTicks(); ++n)
+  {
+    CHECK_BOOL(loop->GetTickProfile(n, profile), true);
+    const double parts = profile[vtkHapticLoop::ProfileForceModel] + profile[vtkHapticLoop::ProfileCut] + profile[vtkHapticLoop::ProfileNerveMonitor];
+    overfull += parts > profile[vtkHapticLoop::ProfileDuration] + 0.01 ? 1 : 0;
+    cuttingTicks += profile[vtkHapticLoop::ProfileCut] > 0.0 ? 1 : 0;
+    CHECK_BOOL(profile[vtkHapticLoop::ProfilePageFaults] >= 0.0 && profile[vtkHapticLoop::ProfilePreemptions] >= 0.0, true);
+  }
+  CHECK_INT(overfull, 0);
+  std::cout << cuttingTicks << " of " << recorded << " ticks cut" << std::endl;
+  CHECK_BOOL(cuttingTicks > 100, true);
+  CHECK_BOOL(loop->GetTickProfile(recorded, profile), false);
+  CHECK_BOOL(loop->GetTickProfile(-1, profile), false);
+  CHECK_DOUBLE(loop->GetCutterDurationPercentile(100.0), 0.0);
+
   // Forces the device cannot render: not a number, or above its maximum.
   CHECK_BOOL(device->SetForce(nan), false);
   device->GetCommandedForce(force);

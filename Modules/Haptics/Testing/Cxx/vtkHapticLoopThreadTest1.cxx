@@ -1,13 +1,14 @@
 // SPDX-FileCopyrightText: VolumeCutting developers
 // SPDX-License-Identifier: Apache-2.0
 // The haptic loop's threads, also run under ThreadSanitizer: the loop's
-// thread drills the field while a hand thread pushes device poses, a
-// renderer thread reads the field (bricks, distances, stamps) and the main
-// thread reads the display side and drains the loop's reports, then
-// unplugs and replugs the device. A protected ball on the hand's circle
-// keeps the loop's shield preparer busy meanwhile, so that its thread, too,
-// runs under ThreadSanitizer. With cuts only, no stored sample may ever grow,
-// and no copy may be torn.
+// thread drills the field (its cutter cuts the strokes the ticks queue,
+// while the force model reads the field) while a hand thread pushes device
+// poses, a renderer thread reads the field (bricks, distances, stamps) and
+// the main thread reads the display side and drains the loop's reports,
+// then unplugs and replugs the device. A protected ball on the hand's
+// circle keeps the loop's shield preparer busy meanwhile, so that its
+// thread, too, runs under ThreadSanitizer; nothing of the ball may be cut.
+// With cuts only, no stored sample may ever grow, and no copy may be torn.
 #include "vtkHapticTestScene.h"
 
 #include "vtkHapticForceModel.h"
@@ -162,6 +163,37 @@ int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
             << " built in ticks" << std::endl;
   CHECK_BOOL(loop->GetPrepareShieldAhead(), true);
   CHECK_BOOL(protection->GetNumberOfPreparedBricks() > 0, true);
+  // The cutter cut every segment the ticks queued (the ticks cut nothing,
+  // so built no shield), the strokes' ends included: at most an undo step
+  // a press of the drill, the last stroke closed.
+  std::cout << "cutter: segment p50 " << loop->GetCutterDurationPercentile(50.0) << " us, max " << loop->GetCutterDurationPercentile(100.0)
+            << " us; longest from tick to cut " << loop->GetMaximumCutLatency() << " us" << std::endl;
+  CHECK_BOOL(loop->GetAsynchronousCutting(), true);
+  CHECK_INT(static_cast<int>(loop->GetNumberOfShieldBricksBuiltInTicks()), 0);
+  CHECK_BOOL(loop->GetCutterDurationPercentile(50.0) > 0.0, true);
+  CHECK_BOOL(loop->GetMaximumCutLatency() >= loop->GetCutterDurationPercentile(100.0), true);
+  CHECK_BOOL(scene.Field->GetNumberOfUndoSteps() >= 1, true);
+  CHECK_BOOL(scene.Field->GetNumberOfUndoSteps() <= loop->GetNumberOfDrillPresses(), true);
+  CHECK_INT(loop->GetNumberOfDrillPresses(), loop->GetNumberOfDrillReleases());
+  // Nothing of the protected ball was removed by the cutter's strokes.
+  int protectedRemoved = 0;
+  for (int k = 0; k < scene.Size; ++k)
+  {
+    for (int j = 0; j < scene.Size; ++j)
+    {
+      for (int i = 0; i < scene.Size; ++i)
+      {
+        if (*static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) != 0)
+        {
+          const double ijk[4] = { double(i), double(j), double(k), 1.0 };
+          double ras[4];
+          scene.IJKToRAS->MultiplyPoint(ijk, ras);
+          protectedRemoved += scene.Field->GetSignedDistance(ras) > 0.0 ? 0 : 1;
+        }
+      }
+    }
+  }
+  CHECK_INT(protectedRemoved, 0);
   CHECK_BOOL(consistent.load(), true);
   CHECK_BOOL(cuts > 0, true);
   CHECK_BOOL(reads.load() > 0, true);

@@ -28,10 +28,15 @@ Real data with protected structures: the temporal-bone case
 (``data.temporalbone``: 288^3 voxels of 0.15 mm, a labelmap drawn slice by
 slice, loaded through ``owndata`` as a user's files, 11 structures
 protected), the same recorded session drilled along the floor of the ear
-canal, without rendering, with the loop's shield preparer (the shield of the
-protected structures built ahead of the tool off the haptic thread) against
-the same replay with the haptic thread building every shield brick it first
-reaches; the shield is forgotten before each replay, so both start from none.
+canal, without rendering, with the loop's cutter thread cutting the segments
+the ticks queue (the default) against the same replay cutting in the ticks
+(both with the shield preparer), in alternating pairs; the cut and the
+shield are forgotten before each replay, so every replay starts from none.
+Before each pair the same loop runs with ticks that do nothing (a virtual
+device in the air of a 4-voxel CT, ``hapticsjob.idle_loop``): its longest
+tick and its overruns are this machine's own scheduling noise, against which
+the replays' figures are read. The slowest ticks' profiles (force model,
+cut, monitor, page faults, preemptions) are kept with the rows.
 """
 
 from __future__ import annotations
@@ -155,8 +160,12 @@ def _replay(application, cut_node, plan, out_dir, frame):
 TEMPORAL_BONE_PLAN = dict(entry=(20.0, 5.0, -2.5), direction=(-1.0, 0.0, 0.0), surface_radius=0.0)
 
 
+#: Alternating pairs of temporal-bone replays (cutter thread, cutting in the ticks).
+TEMPORAL_BONE_PAIRS = 3
+
+
 def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
-    """The replay on the temporal-bone case, with and without the shield preparer, same run."""
+    """Replays on the temporal-bone case, with the loop's cutter and cutting in the ticks, in alternating pairs."""
 
     application = HeadlessSlicer()
     files = temporalbone.cached_case_files()
@@ -169,43 +178,74 @@ def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
     plan = SimpleNamespace(**{key: np.asarray(value) if isinstance(value, tuple) else value
                               for key, value in TEMPORAL_BONE_PLAN.items()})
     protection = logic.GetCutField(cut_node).GetProtection()
-    runs = {}
-    for ahead in (False, True):
-        logic.ClearCut(cut_node)
-        protection.ClearBricks()
-        folder = out_dir / f"temporalbone-{'ahead' if ahead else 'in-ticks'}"
-        folder.mkdir()
-        runs[ahead] = hapticsjob.run(application, cut_node, plan, folder, prepare_shield_ahead=ahead)
+    runs = {True: [], False: []}
+    idle = []
+    for pair in range(TEMPORAL_BONE_PAIRS):
+        idle.append(hapticsjob.idle_loop())
+        for cutter in (True, False):
+            logic.ClearCut(cut_node)
+            protection.ClearBricks()
+            folder = out_dir / f"temporalbone-{pair}-{'cutter' if cutter else 'in-ticks'}"
+            folder.mkdir()
+            runs[cutter].append(hapticsjob.run(application, cut_node, plan, folder, asynchronous_cutting=cutter))
+
+    def worst(replays, key):
+        return max(replay[key] for replay in replays)
+
     after, before = runs[True], runs[False]
+    ticks = sum(replay["ticks_run"] for replay in after)
     where = (f"temporal-bone case ({'x'.join(str(n) for n in temporalbone.DIMENSIONS)} voxels of "
-             f"{temporalbone.SPACING} mm, {after['protected_segments']} protected structures, via owndata), "
-             f"replayed drilling along the ear canal ({after['ticks_run']} ticks, no rendering)")
-    baseline = "the same replay, same run, with the haptic thread building the shield bricks it first reaches"
+             f"{temporalbone.SPACING} mm, {after[0]['protected_segments']} protected structures, via owndata), "
+             f"replayed drilling along the ear canal ({TEMPORAL_BONE_PAIRS} replays of {after[0]['ticks_run']} ticks, "
+             f"no rendering), cutter thread")
+    baseline = (f"the same replays cutting in the ticks, alternating with them in the same run "
+                f"(shield preparer on in both)")
     results = []
-    for label, key in (("p50", "tick_us_p50"), ("p99", "tick_us_p99"), ("max", "tick_us_max")):
-        results.append(measurement(f"one haptic tick on the {where}, shield prepared ahead: {label}", after[key], "us",
-                                   f"{baseline}: {label}", before[key], after["ticks_run"], machine))
-    # The haptic thread's own CPU clock: the tick's compute without the preemption of this shared machine.
-    for label, key in (("p99", "tick_cpu_us_p99"), ("max", "tick_cpu_us_max")):
-        results.append(measurement(f"the same tick, processor time of the haptic thread, shield prepared ahead: {label}",
-                                   after[key], "us", f"{baseline}, processor time: {label}", before[key],
-                                   after["ticks_run"], machine))
-    results.append(measurement(f"haptic loop overruns on the {where}, shield prepared ahead", after["overruns"], "ticks",
-                               baseline, before["overruns"], 1, machine))
-    results.append(measurement(f"shield bricks the haptic thread built in its ticks on the {where}, shield prepared ahead",
-                               after["shield_bricks_built_in_ticks"], "bricks", baseline,
-                               before["shield_bricks_built_in_ticks"], 1, machine))
-    results.append(measurement(f"the cut stroke's part of a tick on the {where}, shield prepared ahead: max",
-                               after["cut_us_max"], "us", f"{baseline}: max", before["cut_us_max"], after["ticks_run"],
+    for label, key in (("p50", "tick_us_p50"), ("p99", "tick_us_p99")):
+        median = float(np.median([replay[key] for replay in after]))
+        results.append(measurement(f"one haptic tick on the {where}: {label} (median of the replays)", median, "us",
+                                   f"{baseline}: {label}", float(np.median([replay[key] for replay in before])),
+                                   ticks, machine))
+    results.append(measurement(f"one haptic tick on the {where}: max (over the replays)", worst(after, "tick_us_max"),
+                               "us", f"{baseline}: max", worst(before, "tick_us_max"), ticks, machine))
+    results.append(measurement(f"the same tick, processor time of the haptic thread: max (over the replays)",
+                               worst(after, "tick_cpu_us_max"), "us", f"{baseline}, processor time: max",
+                               worst(before, "tick_cpu_us_max"), ticks, machine))
+    results.append(measurement(f"haptic loop overruns on the {where} (all replays)",
+                               sum(replay["overruns"] for replay in after), "ticks", baseline,
+                               sum(replay["overruns"] for replay in before), 1, machine))
+    results.append(measurement(f"shield bricks the haptic thread built in its ticks on the {where} (all replays)",
+                               sum(replay["shield_bricks_built_in_ticks"] for replay in after), "bricks", baseline,
+                               sum(replay["shield_bricks_built_in_ticks"] for replay in before), 1, machine))
+    results.append(measurement(f"the cut's part of a tick on the {where} (queueing the segment): max",
+                               worst(after, "cut_us_max"), "us", f"{baseline}: the cut stroke's part, max",
+                               worst(before, "cut_us_max"), ticks, machine))
+    results.append(measurement(f"one segment cut by the cutter thread on the {where}: p99 (median of the replays)",
+                               float(np.median([replay["cutter_us_p99"] for replay in after])), "us",
+                               f"{baseline}: the cut stroke's part of a tick, p99",
+                               float(np.median([replay["cut_us_p99"] for replay in before])), ticks, machine))
+    results.append(measurement(f"longest time from a tick to its segment cut by the cutter on the {where}",
+                               worst(after, "cut_latency_us_max"), "us", "one period of the 1 kHz loop", 1000.0, 1,
                                machine))
-    results.append(measurement(f"longest tick that built shield bricks on the {where}, shield prepared ahead (0: none)",
-                               after["tick_us_max_building_shield"], "us", baseline,
-                               before["tick_us_max_building_shield"], 1, machine))
-    results.append(measurement(f"cut volume of the replay on the {where}, shield prepared ahead (mm^3)",
-                               after["removed_volume_mm3"], "mm^3", f"{baseline} (the same shield: ratio 1)",
-                               before["removed_volume_mm3"], 1, machine))
+    results.append(measurement(f"cut volume of the replay on the {where} (mm^3, first replay)",
+                               after[0]["removed_volume_mm3"], "mm^3", f"{baseline} (the same strokes: ratio about 1)",
+                               before[0]["removed_volume_mm3"], 1, machine))
+    results.append(measurement(
+        "the machine's own noise: longest tick of the same 1 kHz loop with ticks that do nothing, before each pair "
+        f"({TEMPORAL_BONE_PAIRS} runs of 4.5 s, max)", max(run["tick_us_max"] for run in idle), "us",
+        "the cutter thread's replays: max tick (above)", worst(after, "tick_us_max"),
+        sum(run["ticks_run"] for run in idle), machine))
+    results.append(measurement(
+        "the machine's own noise: overruns of the do-nothing loop (all runs)", sum(run["overruns"] for run in idle),
+        "ticks", "the cutter thread's replays: overruns (above)", sum(replay["overruns"] for replay in after), 1,
+        machine))
+    profiles = {"cutter": [replay["tick_profile"] for replay in after],
+                "in_ticks": [replay["tick_profile"] for replay in before],
+                "idle": [run["profile"] for run in idle]}
     for row in results:
-        row["real_time_priority"] = after["real_time_priority"]
+        row["real_time_priority"] = after[0]["real_time_priority"]
+    results[2]["slowest_ticks"] = {name: [tick for profile in group for tick in profile["slowest"][:2]]
+                                   for name, group in profiles.items()}
     return results
 
 

@@ -98,6 +98,87 @@ def active_burr(scene, cut_node):
     return tool, True
 
 
+#: A tick slower than this (us) is a slow tick in :func:`tick_profile` (half the 1 kHz period: issue 28's target).
+SLOW_TICK_US = 500.0
+#: The parts of a tick's profile, in ``vtkHapticLoop.GetTickProfile``'s order.
+PROFILE_FIELDS = ("tick_us", "cpu_us", "force_model_us", "cut_us", "nerve_monitor_us", "shield_bricks_built",
+                  "page_faults", "preemptions")
+
+
+def tick_profile(loop, slowest: int = 5) -> dict:
+    """What the loop's kept ticks spent their time on: the slowest ticks part by part, and the slow ones' totals.
+
+    A slow tick whose processor time is short and which was preempted lost
+    its time to the machine; one with page faults touched new memory; the
+    force model's, the cut's and the monitor's parts are the product's own.
+    """
+    profiles = np.zeros((loop.GetNumberOfKeptTicks(), len(PROFILE_FIELDS)))
+    row = [0.0] * len(PROFILE_FIELDS)
+    for n in range(len(profiles)):
+        loop.GetTickProfile(n, row)
+        profiles[n] = row
+    if not len(profiles):
+        return {"ticks": 0}
+    order = np.argsort(profiles[:, 0])[::-1][:slowest]
+    slow = profiles[profiles[:, 0] > SLOW_TICK_US]
+    return {
+        "ticks": len(profiles),
+        "slow_tick_us": SLOW_TICK_US,
+        "slow_ticks": int(len(slow)),
+        # Slow ticks whose own compute (processor time) was not slow: the machine took the time.
+        "slow_ticks_preempted": int(np.sum((slow[:, 1] <= SLOW_TICK_US) & (slow[:, 7] > 0))),
+        "page_faults": int(profiles[:, 6].sum()),
+        "ticks_with_page_faults": int(np.sum(profiles[:, 6] > 0)),
+        "preemptions": int(profiles[:, 7].sum()),
+        "p99_us": {name: round(float(np.percentile(profiles[:, i], 99)), 1) for i, name in enumerate(PROFILE_FIELDS)},
+        "max_us": {name: round(float(profiles[:, i].max()), 1) for i, name in enumerate(PROFILE_FIELDS)},
+        "slowest": [{"tick": int(n), **{name: round(float(profiles[n, i]), 1) for i, name in enumerate(PROFILE_FIELDS)}}
+                    for n in order],
+    }
+
+
+def idle_loop(seconds: float = 4.5) -> dict:
+    """The machine's own noise: the haptic loop at 1 kHz on the same thread set-up, with ticks that do next to nothing.
+
+    A virtual device held still in the air of a 4-voxel CT, no cut field, no
+    monitor: a tick is a device read and a force-model step out of contact
+    (a few microseconds), so its longest durations, overruns and jitter are
+    what the scheduler of this machine gives any 1 kHz thread.
+    """
+    image = vtk.vtkImageData()
+    image.SetDimensions(4, 4, 4)
+    image.AllocateScalars(vtk.VTK_SHORT, 1)
+    image.GetPointData().GetScalars().Fill(-1000)
+    model = slicer.vtkHapticForceModel()
+    model.SetAnatomy(image, vtk.vtkMatrix4x4())
+    model.SetSurfaceIsoValue(300.0)
+    device = slicer.vtkVirtualHapticDevice()
+    if not device.Open():
+        raise RuntimeError("the virtual haptic device could not be opened (see the log)")
+    device.SetPose([1.5, 1.5, 1.5], 0)
+    loop = slicer.vtkHapticLoop()
+    loop.SetRate(RATE_HZ)
+    loop.SetDevice(device)
+    loop.SetForceModel(model)
+    if not loop.Start():
+        raise RuntimeError("the idle haptic loop could not start (see the log)")
+    time.sleep(seconds)
+    loop.Stop()
+    device.Close()
+    return {
+        "ticks_run": int(loop.GetNumberOfTicks()),
+        "tick_us_p50": round(loop.GetTickDurationPercentile(50.0), 1),
+        "tick_us_p99": round(loop.GetTickDurationPercentile(99.0), 1),
+        "tick_us_max": round(loop.GetMaximumTickDuration(), 1),
+        "tick_cpu_us_max": round(loop.GetTickProcessorTimePercentile(100.0), 1),
+        "period_jitter_us_p99": round(loop.GetPeriodJitterPercentile(99.0), 1),
+        "period_jitter_us_max": round(loop.GetMaximumPeriodJitter(), 1),
+        "overruns": int(loop.GetNumberOfOverruns()),
+        "real_time_priority": bool(loop.GetRealTimePriority()),
+        "profile": tick_profile(loop),
+    }
+
+
 def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
     """The hand's input, tick by tick, as a recording a replay device reads; returns its ticks."""
     recorder = slicer.vtkHapticRecorder()
@@ -118,7 +199,8 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
     return recorder.GetNumberOfTicks()
 
 
-def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None) -> dict:
+def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None,
+        asynchronous_cutting: bool = True) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
@@ -126,7 +208,9 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     cuts it); otherwise this thread sleeps a display period between updates.
     ``prepare_shield_ahead`` False leaves the shield of protected structures
     to be built by the haptic thread where it first reaches it (the
-    comparison for the loop's preparer, ``vtkHapticLoop.SetPrepareShieldAhead``).
+    comparison for the loop's preparer, ``vtkHapticLoop.SetPrepareShieldAhead``);
+    ``asynchronous_cutting`` False cuts in the ticks instead of on the loop's
+    cutter thread (``vtkHapticLoop.SetAsynchronousCutting``).
     The replayed ticks are also saved as a complete recording
     (``haptic_session.json``, ``recording.from_haptic_ticks``) on ``scan``
     (the scan descriptor a recording names), for grading.
@@ -160,6 +244,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     loop = session.GetLoop()
     loop.SetRate(RATE_HZ)
     loop.SetPrepareShieldAhead(bool(prepare_shield_ahead))
+    loop.SetAsynchronousCutting(bool(asynchronous_cutting))
     replayed = slicer.vtkHapticRecorder()
     replayed.SetCapacity(ticks + 1000)
     loop.SetRecorder(replayed)
@@ -273,6 +358,10 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "overruns": int(loop.GetNumberOfOverruns()),
         "cut_us_p99": round(loop.GetCutDurationPercentile(99.0), 1),
         "cut_us_max": round(loop.GetCutDurationPercentile(100.0), 1),
+        "asynchronous_cutting": bool(loop.GetAsynchronousCutting()),
+        "cutter_us_p99": round(loop.GetCutterDurationPercentile(99.0), 1),
+        "cutter_us_max": round(loop.GetCutterDurationPercentile(100.0), 1),
+        "cut_latency_us_max": round(loop.GetMaximumCutLatency(), 1),
         "prepare_shield_ahead": bool(loop.GetPrepareShieldAhead()),
         "protected_segments": len(cut_node.GetProtectedSegmentIDs()),
         "shield_bricks_built_in_ticks": int(loop.GetNumberOfShieldBricksBuiltInTicks()),
@@ -280,6 +369,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "ticks_building_shield": int(loop.GetNumberOfTicksBuildingShield()),
         "tick_us_max_building_shield": round(loop.GetMaximumTickDurationBuildingShield(), 1),
         "real_time_priority": bool(loop.GetRealTimePriority()),
+        "tick_profile": tick_profile(loop),
         "nerve_monitor": nerve_monitor,
         "wall_s": round(wall_s, 2),
     }
