@@ -1,6 +1,7 @@
 """Several users: one application process per browser session, through wslink's launcher (how Kitware deploys trame).
 
-    python -m VolumeCuttingLib.webapp.launcher [--host H] [--port N] [--sessions K] [--folder DIR] [-- APP OPTIONS]
+    python -m VolumeCuttingLib.webapp.launcher [--host H] [--port N] [--sessions K] [--folder DIR] [--start-timeout S]
+                                               [-- APP OPTIONS]
 
 One application process holds one scene. The launcher serves the page; each
 browser that opens it asks the launcher for a session, which starts
@@ -43,7 +44,8 @@ def write_page(folder: Path) -> Path:
     return www
 
 
-def launcher_configuration(www: Path, host: str, port: int, sessions: int, log_dir: Path, app_options: list[str]) -> dict:
+def launcher_configuration(www: Path, host: str, port: int, sessions: int, log_dir: Path, app_options: list[str],
+                           start_timeout_s: int = 120) -> dict:
     """wslink launcher configuration: the page at ``host:port``, sessions on the next ``sessions`` ports."""
     return {
         "configuration": {
@@ -52,7 +54,9 @@ def launcher_configuration(www: Path, host: str, port: int, sessions: int, log_d
             "endpoint": "paraview",  # where trame's page asks for a session by default
             "content": str(www),
             "sessionURL": "ws://${host}:${port}/ws",
-            "timeout": 120,
+            # A session not ready within this is ended and its page refused; several starting at once on a small
+            # machine take longer than one.
+            "timeout": start_timeout_s,
             "log_dir": str(log_dir),
             # The session-to-port table a reverse proxy (Apache's RewriteMap) can route by.
             "proxy_file": str(log_dir.parent / "proxy-mapping.txt"),
@@ -81,13 +85,18 @@ def main(argv=None) -> int:
     parser.add_argument("--port", type=int, default=9000, help="port of the page; sessions use the next ports")
     parser.add_argument("--sessions", type=int, default=4, help="at most this many users at once (one process each)")
     parser.add_argument("--folder", type=Path, default=Path("out/webapp-launcher"), help="where the page and the configuration go")
+    parser.add_argument("--start-timeout", type=int, default=120,
+                        help="seconds a session may take to start before the launcher gives up on it")
     args = parser.parse_args(arguments)
     if args.sessions < 1:
         parser.error(f"--sessions {args.sessions}: at least one")
+    if args.start_timeout < 1:
+        parser.error(f"--start-timeout {args.start_timeout}: at least one second")
     folder = args.folder.resolve()
     (folder / "logs").mkdir(parents=True, exist_ok=True)
     www = write_page(folder)
-    configuration = launcher_configuration(www, args.host, args.port, args.sessions, folder / "logs", app_options)
+    configuration = launcher_configuration(www, args.host, args.port, args.sessions, folder / "logs", app_options,
+                                           args.start_timeout)
     config_path = folder / "launcher.json"
     config_path.write_text(json.dumps(configuration, indent=2) + "\n")
     print(f"Open http://{args.host}:{args.port}/ (up to {args.sessions} users; configuration: {config_path})", flush=True)
