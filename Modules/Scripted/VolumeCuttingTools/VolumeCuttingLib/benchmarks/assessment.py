@@ -63,6 +63,7 @@ from .haptics import _ball_scene
 
 #: Replays of the haptic session with the recorder and without it (each).
 RECORDING_REPLAYS = 4
+VOLUME_SPREAD_LIMIT = 0.005  # of the largest removed volume, between replays of one recording
 #: Threads a one-core child is held to, by every library that reads one of these.
 ONE_CORE_ENVIRONMENT = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                                                "VTK_SMP_MAX_THREADS", "NUMEXPR_NUM_THREADS")}
@@ -148,9 +149,12 @@ def _recording_cost(machine) -> list[dict]:
     with_recorder, without = runs[True], runs[False]
     if any(run["recorded"] < run["ticks"] for run in with_recorder):
         raise RuntimeError("the recorder kept fewer ticks than the loop ran")
-    volumes = {round(run["removed_mm3"], 6) for run in with_recorder + without}
-    if len(volumes) != 1:
-        raise RuntimeError(f"the replays cut different volumes ({sorted(volumes)} mm^3): not the same input")
+    # The loop's cutter thread cuts a few milliseconds behind the ticks, so the force (and with it the proxy's path)
+    # reads a field that differs slightly from run to run: the same input cuts the same volume within a fraction of
+    # a percent, not bit for bit. A larger spread means the replays were not the same input.
+    volumes = sorted(run["removed_mm3"] for run in with_recorder + without)
+    if volumes[-1] - volumes[0] > VOLUME_SPREAD_LIMIT * volumes[-1]:
+        raise RuntimeError(f"the replays cut different volumes ({volumes} mm^3): not the same input")
 
     def median(runs_, key):
         return statistics.median(run[key] for run in runs_)
