@@ -151,7 +151,7 @@ def instructor_target(time: float) -> tuple[float, float, float]:
 
 
 def air_force_model():
-    """A force model over air only: the rehearsal's tools touch nothing but each other."""
+    """A force model over air only: the rehearsal's tools touch nothing but each other, idle ticks nothing."""
     image = vtk.vtkImageData()
     image.SetDimensions(4, 4, 4)
     image.AllocateScalars(vtk.VTK_FLOAT, 1)

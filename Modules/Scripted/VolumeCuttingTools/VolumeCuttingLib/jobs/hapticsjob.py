@@ -27,6 +27,7 @@ import vtk
 
 from ..config import toolconfig
 from ..cutting import recording
+from ..collaboration import forcecoupling
 from ..feedback import nervemonitor
 
 #: The tool the session drills with.
@@ -145,13 +146,7 @@ def idle_loop(seconds: float = 4.5) -> dict:
     (a few microseconds), so its longest durations, overruns and jitter are
     what the scheduler of this machine gives any 1 kHz thread.
     """
-    image = vtk.vtkImageData()
-    image.SetDimensions(4, 4, 4)
-    image.AllocateScalars(vtk.VTK_SHORT, 1)
-    image.GetPointData().GetScalars().Fill(-1000)
-    model = slicer.vtkHapticForceModel()
-    model.SetAnatomy(image, vtk.vtkMatrix4x4())
-    model.SetSurfaceIsoValue(300.0)
+    model = forcecoupling.air_force_model()
     device = slicer.vtkVirtualHapticDevice()
     if not device.Open():
         raise RuntimeError("the virtual haptic device could not be opened (see the log)")
