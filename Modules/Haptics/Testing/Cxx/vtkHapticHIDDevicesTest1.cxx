@@ -8,6 +8,7 @@
 // report their pedals, and a pedal runs the haptic loop's drill.
 #include "vtkHapticFakeHIDDevice.h"
 #include "vtkHapticTestScene.h"
+#include "vtkHapticTestWaiting.h"
 
 #include "vtkFootSwitchDevice.h"
 #include "vtkHIDConnection.h"
@@ -28,20 +29,6 @@
 
 namespace
 {
-/// Wait up to two seconds for a condition the devices' threads bring about.
-bool WaitFor(const std::function<bool()>& condition)
-{
-  for (int n = 0; n < 400; ++n)
-  {
-    if (condition())
-    {
-      return true;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return condition();
-}
-
 std::vector<unsigned char> SixAxes(int x, int y, int z, int rx, int ry, int rz)
 {
   std::vector<unsigned char> report = { 0x01 };
@@ -90,17 +77,30 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   mouse->AddObserver(vtkHapticDevice::DeviceDisconnectedEvent, observer);
   CHECK_BOOL(mouse->Open(), true);
   CHECK_STRING(mouse->GetConnection()->GetOpenedPath(), "/dev/hidraw0");
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetNumberOfSamples() > 3; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetNumberOfSamples() > 3; }), true);
 
-  // Full deflection to the right for about 0.2 s: 50 mm/s moves it about 10 mm.
+  // Full deflection to the right moves it at 50 mm/s: until it has gone
+  // 2 mm, then released; it cannot have gone faster than 50 mm/s over the
+  // time it was held.
+  double position[3] = { 0.0, 0.0, 0.0 };
+  const auto pushed = std::chrono::steady_clock::now();
   fakeMouse.SetStream(SixAxes(350, 0, 0, 0, 0, 0));
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetLatestPosition(position) && position[0] > 2.0; }), true);
   fakeMouse.SetStream(SixAxes(0, 0, 0, 0, 0, 0));
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  double position[3];
+  // Released once two readings 30 ms apart agree (the reports already queued
+  // at full deflection may still be on their way).
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() {
+    double before[3];
+    mouse->GetLatestPosition(before);
+    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    mouse->GetLatestPosition(position);
+    return position[0] == before[0];
+  }),
+    true);
+  const double held = std::chrono::duration<double>(std::chrono::steady_clock::now() - pushed).count();
   CHECK_BOOL(mouse->GetLatestPosition(position), true);
-  std::cout << "SpaceMouse moved to x = " << position[0] << " mm" << std::endl;
-  CHECK_BOOL(position[0] > 2.0 && position[0] < 40.0, true);
+  std::cout << "SpaceMouse moved to x = " << position[0] << " mm in " << held << " s" << std::endl;
+  CHECK_BOOL(position[0] > 2.0 && position[0] < 50.0 * held + 1.0, true);
   CHECK_DOUBLE(position[1], 0.0);
   // Within the dead zone nothing moves.
   fakeMouse.SetStream(SixAxes(5, -8, 10, 3, 0, -2));
@@ -113,19 +113,19 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   fakeMouse.SetStream(SixAxes(0, 0, 0, 0, 0, 0));
   double orientation[4];
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetLatestOrientation(orientation) && orientation[3] > 0.01; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetLatestOrientation(orientation) && orientation[3] > 0.01; }), true);
   // Buttons, the LED, and garbage.
   fakeMouse.Send({ 0x03, 0x02, 0x00 });
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetLatestButtons() == 2u; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetLatestButtons() == 2u; }), true);
   CHECK_BOOL(mouse->SetLED(true), true);
   const auto written = fakeMouse.Written();
   CHECK_BOOL(!written.empty() && written.back() == std::vector<unsigned char>({ 0x04, 0x01 }), true);
   fakeMouse.Send({ 0x01, 0x10 });
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetNumberOfRejectedInputs() == 1; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetNumberOfRejectedInputs() == 1; }), true);
 
   // Unplugged: lost, reported, not found again while it is away...
   fakeMouse.Unplug();
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetConnectionState() == vtkHapticDevice::Lost; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetConnectionState() == vtkHapticDevice::Lost; }), true);
   TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
   mouse->ProcessConnectionEvents();
   TESTING_OUTPUT_ASSERT_WARNINGS_END();
@@ -139,7 +139,7 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_INT(events[0], 1);
   CHECK_BOOL(mouse->IsConnected(), true);
   CHECK_INT(mouse->GetNumberOfConnections(), 2);
-  CHECK_BOOL(WaitFor([&]() { return mouse->GetNumberOfSamples() > 3; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return mouse->GetNumberOfSamples() > 3; }), true);
   mouse->Close();
   CHECK_INT(mouse->GetConnectionState(), vtkHapticDevice::Closed);
 
@@ -152,9 +152,9 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_BOOL(vec->Open(), true);
   CHECK_INT(vec->GetConnection()->GetOpenedVendorID(), 0x05f3);
   fakeVEC.SetStream({ 0x04, 0x00 });
-  CHECK_BOOL(WaitFor([&]() { return vec->GetLatestButtons() == 4u; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return vec->GetLatestButtons() == 4u; }), true);
   fakeVEC.Send({ 0xf0, 0x00 });
-  CHECK_BOOL(WaitFor([&]() { return vec->GetNumberOfRejectedInputs() == 1; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return vec->GetNumberOfRejectedInputs() == 1; }), true);
   CHECK_INT(static_cast<int>(vec->GetLatestButtons()), 4);
 
   vtkHapticFakeHIDDevice fakeKeyboard(bed, 0x0c45, 0x7403, 2, Descriptor);
@@ -165,7 +165,7 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   keyboard->GetConnection()->SetDevicePath("/dev/hidraw2");
   CHECK_BOOL(keyboard->Open(), true);
   fakeKeyboard.SetStream({ 0, 0, 0x05, 0, 0, 0, 0, 0 });
-  CHECK_BOOL(WaitFor([&]() { return keyboard->GetLatestButtons() == 2u; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return keyboard->GetLatestButtons() == 2u; }), true);
 
   // The pedal runs the loop's drill; released, it stops.
   vtkHapticTestScene scene;
@@ -184,7 +184,7 @@ int vtkHapticHIDDevicesTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_BOOL(loop->RunTicks(3), true);
   CHECK_BOOL(loop->GetDrilling(), true);
   fakeVEC.SetStream({ 0x00, 0x00 });
-  CHECK_BOOL(WaitFor([&]() { return vec->GetLatestButtons() == 0u; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return vec->GetLatestButtons() == 0u; }), true);
   CHECK_BOOL(loop->RunTicks(3), true);
   CHECK_BOOL(loop->GetDrilling(), false);
   loop->Stop();

@@ -304,10 +304,18 @@ int vtkHapticLoopTest1(int argc, char* argv[])
   TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
   CHECK_BOOL(loop->RunTicks(1), false);
   TESTING_OUTPUT_ASSERT_ERRORS_END();
+  // At least 30 ticks (0.03 s of a 1 kHz loop), waited for up to 20 s: how
+  // steady the ticks are is the benchmark's business, and the sanitizer
+  // builds run this test starved of a core.
+  const auto started = std::chrono::steady_clock::now();
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  while (loop->GetNumberOfTicks() <= 30 && std::chrono::steady_clock::now() - started < std::chrono::seconds(20))
+  {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
   loop->Stop();
   CHECK_BOOL(loop->IsRunning(), false);
-  std::cout << loop->GetNumberOfTicks() << " ticks in 0.3 s; tick p50 " << loop->GetTickDurationPercentile(50) << " us, period jitter p99 "
+  std::cout << loop->GetNumberOfTicks() << " ticks in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() << " s; tick p50 " << loop->GetTickDurationPercentile(50) << " us, period jitter p99 "
             << loop->GetPeriodJitterPercentile(99) << " us" << (loop->GetRealTimePriority() ? " (real-time priority)" : "") << std::endl;
   CHECK_BOOL(loop->GetNumberOfTicks() > 30, true);
   CHECK_BOOL(loop->GetTickDurationPercentile(50) > 0.0, true);

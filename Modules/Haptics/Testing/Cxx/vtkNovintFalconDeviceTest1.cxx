@@ -10,6 +10,7 @@
 // answering or is unplugged is lost, and reconnected (with a new upload
 // after a power cycle) when it is back.
 #include "vtkHapticFakeFalcon.h"
+#include "vtkHapticTestWaiting.h"
 
 #include "vtkFTDIConnection.h"
 #include "vtkFalconFirmwareLoader.h"
@@ -33,19 +34,6 @@
 
 namespace
 {
-bool WaitFor(const std::function<bool()>& condition)
-{
-  for (int n = 0; n < 400; ++n)
-  {
-    if (condition())
-    {
-      return true;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  return condition();
-}
-
 bool Has(const std::vector<std::pair<int, int>>& controls, int request, int value)
 {
   return std::find(controls.begin(), controls.end(), std::make_pair(request, value)) != controls.end();
@@ -112,16 +100,19 @@ int vtkNovintFalconDeviceTest1(int argc, char* argv[])
   CHECK_BOOL(Has(controls, 9, 1), true); // 1 ms latency for 1 kHz frames
 
   // Homing first (absent samples, homing bit sent), then the handle's position.
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetHomedAxes() == 7; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetHomedAxes() == 7; }), true);
   double position[3];
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetLatestPosition(position); }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetLatestPosition(position); }), true);
   std::cout << "Falcon at " << position[0] << " " << position[1] << " " << position[2] << " mm (handle at 5 -3 8)" << std::endl;
   // Encoders quantise the arms to 0.036 degree: a few hundredths of a millimetre.
   CHECK_BOOL(std::sqrt(vtkMath::Distance2BetweenPoints(position, handle)) < 0.2, true);
+  // Frames keep streaming by themselves (how fast is the haptic loop's
+  // benchmark, not a test's: a starved machine must not fail it).
   const int frames = fake.GetNumberOfCommandFrames();
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  std::cout << fake.GetNumberOfCommandFrames() - frames << " frames in 0.1 s" << std::endl;
-  CHECK_BOOL(fake.GetNumberOfCommandFrames() - frames > 10, true);
+  const auto streamStart = std::chrono::steady_clock::now();
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return fake.GetNumberOfCommandFrames() - frames > 10; }), true);
+  std::cout << fake.GetNumberOfCommandFrames() - frames << " frames in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - streamStart).count() << " s" << std::endl;
 
   // A force becomes the motor commands J^T F at that position; a force above
   // 8 N is clamped to 8 N first.
@@ -132,7 +123,7 @@ int vtkNovintFalconDeviceTest1(int argc, char* argv[])
   falcon->GetKinematics()->ForceToMotorCommands(position, force, expected, saturated);
   short motors[3] = { 0, 0, 0 };
   int control = 0;
-  CHECK_BOOL(WaitFor([&]() {
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() {
     fake.GetLastMotors(motors, control);
     return motors[0] == expected[0] && motors[1] == expected[1] && motors[2] == expected[2];
   }),
@@ -143,23 +134,23 @@ int vtkNovintFalconDeviceTest1(int argc, char* argv[])
   CHECK_BOOL(falcon->SetForce(tooStrong), false);
   const double clamped[3] = { 0.0, 0.0, 8.0 };
   falcon->GetKinematics()->ForceToMotorCommands(position, clamped, expected, saturated);
-  CHECK_BOOL(WaitFor([&]() {
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() {
     fake.GetLastMotors(motors, control);
     return motors[0] == expected[0] && motors[1] == expected[1] && motors[2] == expected[2];
   }),
     true);
   fake.SetButtons(0x5);
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetLatestButtons() == 5u; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetLatestButtons() == 5u; }), true);
 
   // Garbage between frames: dropped and counted, frames still read.
   const unsigned long long samples = falcon->GetNumberOfSamples();
   fake.InjectGarbage({ '<', 'A', 'B', 0xff, '>', 0x00, 'Q', '<', 'P' });
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetNumberOfRejectedInputs() > 0; }), true);
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetNumberOfSamples() > samples + 20; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetNumberOfRejectedInputs() > 0; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetNumberOfSamples() > samples + 20; }), true);
 
   // Stops answering: lost after the silence timeout; back without a new upload.
   fake.SetSilent(true);
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetConnectionState() == vtkHapticDevice::Lost; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetConnectionState() == vtkHapticDevice::Lost; }), true);
   TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
   falcon->ProcessConnectionEvents();
   TESTING_OUTPUT_ASSERT_WARNINGS_END();
@@ -172,7 +163,7 @@ int vtkNovintFalconDeviceTest1(int argc, char* argv[])
   // Unplugged: lost; not found while away; plugged back (powered afresh)
   // the firmware goes up again and the Falcon is back.
   fake.Unplug();
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetConnectionState() == vtkHapticDevice::Lost; }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetConnectionState() == vtkHapticDevice::Lost; }), true);
   TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
   falcon->ProcessConnectionEvents();
   TESTING_OUTPUT_ASSERT_WARNINGS_END();
@@ -182,7 +173,7 @@ int vtkNovintFalconDeviceTest1(int argc, char* argv[])
   falcon->ProcessConnectionEvents();
   CHECK_BOOL(falcon->IsConnected(), true);
   CHECK_BOOL(falcon->GetFirmwareUploaded(), true);
-  CHECK_BOOL(WaitFor([&]() { return falcon->GetLatestPosition(position); }), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return falcon->GetLatestPosition(position); }), true);
   CHECK_INT(falcon->GetNumberOfConnections(), 3);
 
   // Closing sends zero force last.
