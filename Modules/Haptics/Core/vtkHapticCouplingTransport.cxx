@@ -146,6 +146,12 @@ struct vtkHapticCouplingTransport::Internals
 {
   SocketHandle Socket = InvalidSocket;
   sockaddr_in Remote{};
+  // Listening: the packets of which host are accepted (INADDR_ANY: any), and whether Remote holds a peer yet.
+  bool Listening = false;
+  std::uint32_t ListenFrom = 0;
+  bool PeerAddressKnown = false;
+  // Remote's address and port (address << 16 | port; 0: none) for readers on other threads.
+  std::atomic<std::uint64_t> PublishedPeer{ 0 };
   int LocalPort = 0;
   unsigned int Session = 0;
   unsigned long long NextSequence = 1;
@@ -181,8 +187,19 @@ struct vtkHapticCouplingTransport::Internals
     return static_cast<double>((this->Random * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
   }
 
+  void PublishPeer()
+  {
+    this->PublishedPeer.store(
+      (static_cast<std::uint64_t>(ntohl(this->Remote.sin_addr.s_addr)) << 16) | ntohs(this->Remote.sin_port),
+      std::memory_order_release);
+  }
+
   bool Write(const unsigned char* bytes)
   {
+    if (!this->PeerAddressKnown)
+    {
+      return false; // listening, and nobody has joined yet: nowhere to send
+    }
     const auto written = sendto(this->Socket, reinterpret_cast<const char*>(bytes), PacketSize, 0,
       reinterpret_cast<const sockaddr*>(&this->Remote), sizeof(this->Remote));
     if (written != PacketSize)
@@ -274,9 +291,9 @@ bool vtkHapticCouplingTransport::Open(const char* localHost, int localPort, cons
 {
   this->Close();
   Internals& internal = *this->Internal;
-  if (!localHost || !remoteHost || localPort < 0 || localPort > 65535 || remotePort <= 0 || remotePort > 65535)
+  if (!localHost || !remoteHost || localPort < 0 || localPort > 65535 || remotePort < 0 || remotePort > 65535)
   {
-    vtkErrorMacro("Open: hosts are required and ports must be 1-65535 (the local one may be 0: any free port)");
+    vtkErrorMacro("Open: hosts are required and ports must be 0-65535 (local 0: any free port; remote 0: listen)");
     return false;
   }
   sockaddr_in local{};
@@ -323,6 +340,17 @@ bool vtkHapticCouplingTransport::Open(const char* localHost, int localPort, cons
   getsockname(internal.Socket, reinterpret_cast<sockaddr*>(&bound), &length);
   internal.LocalPort = ntohs(bound.sin_port);
   internal.Remote = remote;
+  internal.Listening = remotePort == 0;
+  internal.ListenFrom = remote.sin_addr.s_addr;
+  internal.PeerAddressKnown = !internal.Listening;
+  if (internal.PeerAddressKnown)
+  {
+    internal.PublishPeer();
+  }
+  else
+  {
+    internal.PublishedPeer.store(0, std::memory_order_release);
+  }
 
   std::random_device device;
   const auto ticks = static_cast<unsigned int>(std::chrono::steady_clock::now().time_since_epoch().count());
@@ -362,6 +390,8 @@ void vtkHapticCouplingTransport::Close()
 #endif
   internal.WinsockStarted = false;
   internal.LocalPort = 0;
+  internal.PeerAddressKnown = false;
+  internal.PublishedPeer.store(0, std::memory_order_release);
   internal.QueueCount = 0;
 }
 
@@ -381,6 +411,26 @@ int vtkHapticCouplingTransport::GetLocalPort() const
 unsigned int vtkHapticCouplingTransport::GetSession() const
 {
   return this->Internal->Session;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticCouplingTransport::IsListening() const
+{
+  return this->Internal->Listening;
+}
+
+//------------------------------------------------------------------------------
+std::string vtkHapticCouplingTransport::GetPeerAddress() const
+{
+  const std::uint64_t peer = this->Internal->PublishedPeer.load(std::memory_order_acquire);
+  if (peer == 0)
+  {
+    return std::string();
+  }
+  const auto address = static_cast<std::uint32_t>(peer >> 16);
+  return std::to_string(address >> 24) + "." + std::to_string((address >> 16) & 0xFFu) + "." +
+    std::to_string((address >> 8) & 0xFFu) + "." + std::to_string(address & 0xFFu) + ":" +
+    std::to_string(peer & 0xFFFFu);
 }
 
 //------------------------------------------------------------------------------
@@ -434,7 +484,7 @@ bool vtkHapticCouplingTransport::Send(State& state, double now)
 bool vtkHapticCouplingTransport::SendRawDatagram(const unsigned char* bytes, int size)
 {
   Internals& internal = *this->Internal;
-  if (internal.Socket == InvalidSocket || !bytes || size < 0 || size > 65507)
+  if (internal.Socket == InvalidSocket || !internal.PeerAddressKnown || !bytes || size < 0 || size > 65507)
   {
     return false;
   }
@@ -470,7 +520,14 @@ bool vtkHapticCouplingTransport::ReceiveLatest(double now, State& latest)
       }
       continue;
     }
-    if (from.sin_family != AF_INET || from.sin_addr.s_addr != internal.Remote.sin_addr.s_addr)
+    // Listening, a packet from another address than the peer's may replace a peer silent for SessionTimeout.
+    const bool peerSilent = !internal.HavePeer || now - internal.LastAccepted >= this->SessionTimeout;
+    const bool fromPeer = from.sin_family == AF_INET && internal.PeerAddressKnown &&
+      from.sin_addr.s_addr == internal.Remote.sin_addr.s_addr &&
+      (!internal.Listening || from.sin_port == internal.Remote.sin_port);
+    const bool mayJoin = internal.Listening && from.sin_family == AF_INET && peerSilent &&
+      (internal.ListenFrom == htonl(INADDR_ANY) || from.sin_addr.s_addr == internal.ListenFrom);
+    if (!fromPeer && !mayJoin)
     {
       internal.ForeignHost.fetch_add(1, std::memory_order_relaxed);
       continue;
@@ -495,6 +552,13 @@ bool vtkHapticCouplingTransport::ReceiveLatest(double now, State& latest)
     {
       internal.Stale.fetch_add(1, std::memory_order_relaxed);
       continue;
+    }
+    if (!fromPeer)
+    {
+      // The side that joins (or joins again from a new address): replies go where it sends from.
+      internal.Remote = from;
+      internal.PeerAddressKnown = true;
+      internal.PublishPeer();
     }
     internal.HavePeer = true;
     internal.PeerSession = state.Session;
@@ -554,6 +618,8 @@ void vtkHapticCouplingTransport::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Open: " << (this->IsOpen() ? "yes" : "no") << "\n";
   os << indent << "LocalPort: " << this->GetLocalPort() << "\n";
+  os << indent << "Listening: " << (this->IsListening() ? "yes" : "no") << "\n";
+  os << indent << "PeerAddress: " << this->GetPeerAddress() << "\n";
   os << indent << "SessionTimeout: " << this->SessionTimeout << " s\n";
   os << indent << "InjectedDelay: " << this->InjectedDelay << " s\n";
   os << indent << "InjectedLossRate: " << this->InjectedLossRate << "\n";

@@ -38,6 +38,7 @@
 #include "vtkVolumeCuttingHapticsExport.h" // For export macro
 
 #include <memory> // For the internals
+#include <string> // For GetPeerAddress
 
 class VTK_VOLUMECUTTINGHAPTICS_EXPORT vtkHapticCouplingTransport : public vtkObject
 {
@@ -103,6 +104,14 @@ public:
    * GetLocalPort) and address the peer at remoteHost:remotePort (numeric
    * IPv4). False, with an error saying why, otherwise. Allocates the
    * injection queue; starts a new session.
+   *
+   * remotePort 0 listens instead: the peer is whoever sends the first valid
+   * packet (from remoteHost only, unless it is 0.0.0.0), and nothing is sent
+   * until then. The side that waits (the trainee's) need not know the
+   * address of the side that joins, which may be behind a NAT: replies go
+   * where its packets come from. Packets from another address are foreign
+   * while the peer is alive; once it has been silent for SessionTimeout, a
+   * new address may take its place (the instructor's side restarted).
    */
   bool Open(const char* localHost, int localPort, const char* remoteHost, int remotePort);
   void Close();
@@ -113,6 +122,16 @@ public:
 
   /// This side's session nonce (after Open).
   unsigned int GetSession() const;
+
+  /// Whether Open was asked to listen (remote port 0) rather than to address a known peer.
+  bool IsListening() const;
+
+  /**
+   * The peer's address as "host:port": the one given to Open, or, when
+   * listening, the one the accepted packets come from ("" until one came).
+   * Any thread may ask while the loop runs.
+   */
+  std::string GetPeerAddress() const;
 
   ///@{
   /**

@@ -25,6 +25,7 @@
 // ignored; a peer that goes silent fades to no force within PeerTimeout +
 // FadeTime (0.15 s).
 #include "vtkHapticTestScene.h"
+#include "vtkHapticTestWaiting.h"
 
 #include "vtkHapticCoupling.h"
 #include "vtkHapticCouplingTransport.h"
@@ -235,9 +236,10 @@ bool Run(Side& a, Side& b, double start, double duration, Figures& figures, doub
   return true;
 }
 
+/// (Returns EXIT_SUCCESS or EXIT_FAILURE, as the testing macros inside it do: a bool would read their failure as true.)
 /// The trainee holds firm while the instructor pulls along the path; the
 /// trainee's port is probed with bad packets, then the instructor goes silent.
-bool HeldCase(vtkHapticTestScene& scene)
+int HeldCase(vtkHapticTestScene& scene)
 {
   Side a, b;
   a.Device = vtkSmartPointer<vtkVirtualHapticDevice>::New();
@@ -249,7 +251,7 @@ bool HeldCase(vtkHapticTestScene& scene)
   b.Operator.Damping = 0.01;
   if (!Configure(scene, a, 0.005, 0.1, 5, true) || !Configure(scene, b, 0.005, 0.1, 7, true) || !Link(a, b))
   {
-    return false;
+    return EXIT_FAILURE;
   }
   Publish(a);
   Publish(b);
@@ -337,7 +339,50 @@ bool HeldCase(vtkHapticTestScene& scene)
             << " ms after the instructor's last packet (bound " << 1000.0 * fadeBound << " ms)" << std::endl;
   CHECK_BOOL(zeroAfter <= fadeBound + 2.0 * TimeStep, true);
   CHECK_BOOL(zeroAfter > b.Coupling->GetPeerTimeout() - 2.0 * TimeStep, true);
-  return true;
+  return EXIT_SUCCESS;
+}
+
+/// Listening (the trainee's side): the first sender becomes the peer and gets the replies; another address is
+/// foreign while the peer is alive, and takes its place once it has been silent for the session timeout.
+int ListenCase()
+{
+  vtkNew<vtkHapticCouplingTransport> listener;
+  listener->SetSessionTimeout(0.5);
+  CHECK_BOOL(listener->Open("127.0.0.1", 0, "0.0.0.0", 0), true);
+  CHECK_BOOL(listener->IsListening(), true);
+  CHECK_BOOL(listener->GetPeerAddress().empty(), true);
+  vtkNew<vtkHapticCouplingTransport> first;
+  vtkNew<vtkHapticCouplingTransport> second;
+  CHECK_BOOL(first->Open("127.0.0.1", 0, "127.0.0.1", listener->GetLocalPort()), true);
+  CHECK_BOOL(second->Open("127.0.0.1", 0, "127.0.0.1", listener->GetLocalPort()), true);
+  CHECK_BOOL(first->IsListening(), false);
+  vtkHapticCouplingTransport::State state;
+  vtkHapticCouplingTransport::State latest;
+  state.Flags = vtkHapticCouplingTransport::PresentFlag;
+  CHECK_BOOL(listener->Send(state, 0.5), false); // nobody joined: nowhere to send
+  CHECK_BOOL(first->Send(state, 1.0), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return listener->ReceiveLatest(1.0, latest); }), true);
+  const std::string firstAddress = "127.0.0.1:" + std::to_string(first->GetLocalPort());
+  CHECK_STD_STRING(listener->GetPeerAddress(), firstAddress);
+  CHECK_BOOL(latest.Session == first->GetSession(), true);
+  CHECK_BOOL(listener->Send(state, 1.0), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return first->ReceiveLatest(1.0, latest); }), true);
+  CHECK_BOOL(latest.Session == listener->GetSession(), true);
+
+  CHECK_BOOL(second->Send(state, 1.1), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() {
+    listener->ReceiveLatest(1.1, latest);
+    return listener->GetNumberOfForeignHostPackets() == 1;
+  }), true);
+  CHECK_STD_STRING(listener->GetPeerAddress(), firstAddress);
+
+  CHECK_BOOL(second->Send(state, 2.0), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return listener->ReceiveLatest(2.0, latest); }), true);
+  CHECK_STD_STRING(listener->GetPeerAddress(), "127.0.0.1:" + std::to_string(second->GetLocalPort()));
+  CHECK_BOOL(latest.Session == second->GetSession(), true);
+  CHECK_BOOL(listener->Send(state, 2.0), true);
+  CHECK_BOOL(vtkHapticTestWaitFor([&]() { return second->ReceiveLatest(2.0, latest); }), true);
+  return EXIT_SUCCESS;
 }
 
 /// One stability case with two virtual devices (or a replayed instructor).
@@ -447,7 +492,8 @@ int vtkHapticCouplingTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
     CHECK_BOOL(figures.MaximumSeparation < 40.0, true);
   }
 
-  CHECK_BOOL(HeldCase(scene), true);
+  CHECK_EXIT_SUCCESS(HeldCase(scene));
+  CHECK_EXIT_SUCCESS(ListenCase());
 
   // Without the passivity layer, 20 ms of delay breaks the criterion.
   {

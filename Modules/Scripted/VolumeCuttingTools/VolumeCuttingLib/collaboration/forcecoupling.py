@@ -34,7 +34,7 @@ class CouplingSettings:
     """One end of the coupling: where it listens, where its peer is, how stiff, and any injected faults."""
 
     local_port: int
-    peer_port: int
+    peer_port: int                  # 0: listen, the peer is whoever sends first (from peer_host unless 0.0.0.0)
     host: str = LOOPBACK
     peer_host: str = LOOPBACK
     stiffness: float = 0.5          # N per scene mm between the proxies
@@ -46,9 +46,9 @@ class CouplingSettings:
 
     def validate(self) -> None:
         """Raise ValueError naming the first setting that cannot work."""
-        for name, port, lowest in (("local_port", self.local_port, 0), ("peer_port", self.peer_port, 1)):
-            if not isinstance(port, int) or not lowest <= port <= 65535:
-                raise ValueError(f"{name} must be an integer from {lowest} to 65535, not {port!r}")
+        for name, port in (("local_port", self.local_port), ("peer_port", self.peer_port)):
+            if not isinstance(port, int) or not 0 <= port <= 65535:
+                raise ValueError(f"{name} must be an integer from 0 to 65535, not {port!r}")
         for name, host in (("host", self.host), ("peer_host", self.peer_host)):
             try:
                 ipaddress.IPv4Address(host)
@@ -89,8 +89,9 @@ class ForceCoupling:
         self.transport.SetInjectedLossRate(settings.injected_loss)
         self.transport.SetInjectionSeed(settings.seed)
         if not self.transport.Open(settings.host, settings.local_port, settings.peer_host, settings.peer_port):
-            raise OSError(f"the force coupling could not listen on {settings.host}:{settings.local_port} "
-                          f"for its peer at {settings.peer_host}:{settings.peer_port} (port in use?)")
+            peer = "any peer" if settings.peer_port == 0 else f"its peer at {settings.peer_host}:{settings.peer_port}"
+            raise OSError(f"the force coupling could not bind UDP {settings.host}:{settings.local_port} for {peer} "
+                          "(port in use, or not an address of this machine?)")
         self.coupling.SetStiffness(settings.stiffness)
         self.coupling.SetDamping(settings.damping)
         self.coupling.SetMaximumForce(settings.maximum_force)
@@ -119,6 +120,7 @@ class ForceCoupling:
             "tank_mJ": coupling.GetLatestTank(),
             "energy_in_mJ": coupling.GetEnergyIn(),
             "energy_out_mJ": coupling.GetEnergyOut(),
+            "peer": transport.GetPeerAddress(),
             "packets_sent": transport.GetNumberOfPacketsSent(),
             "packets_accepted": transport.GetNumberOfPacketsAccepted(),
             "packets_garbled": transport.GetNumberOfGarbledPackets(),
