@@ -42,7 +42,7 @@ def side_by_side(left, right, path):
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    with AppServer("--phantom", log_path=tmp_path_factory.mktemp("webapp-instructor") / "server.log") as running:
+    with AppServer("--phantom", "--test-hooks", log_path=tmp_path_factory.mktemp("webapp-instructor") / "server.log") as running:
         yield running
 
 

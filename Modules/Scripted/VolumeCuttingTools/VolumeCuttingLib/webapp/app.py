@@ -103,6 +103,7 @@ class Options:
     work_dir: Path | None = None
     records: str | None = None
     openigtlink: igtloptions.BridgeOptions | None = None  # off unless --openigtlink PORT
+    test_hooks: bool = False  # triggers only automated tests may call (--test-hooks)
 
     @property
     def max_upload_bytes(self) -> int:
@@ -129,6 +130,9 @@ def add_arguments(parser) -> None:
     group.add_argument("--records", default=None, metavar="URL",
                        help="trainee records for the Progress panel: SQLAlchemy URL or SQLite file "
                             "(default: $VOLUMECUTTING_RECORDS or ~/.local/share/volumecutting/records.sqlite)")
+    group.add_argument("--test-hooks", action="store_true",
+                       help="for automated tests only: let a page ask for the checksum of the whole cut field "
+                            "(trigger vc_co_checksum); leave off when serving users")
     igtloptions.add_arguments(parser)
 
 
@@ -151,7 +155,8 @@ def options_from_arguments(args) -> Options:
         raise SystemExit(str(error)) from None
     return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
                    max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
-                   navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records, openigtlink=openigtlink)
+                   navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records, openigtlink=openigtlink,
+                   test_hooks=args.test_hooks)
 
 
 def path_allowed(path: Path, folders) -> bool:
