@@ -697,69 +697,45 @@ class IgtlBridge:
 class _ImageMirror:
     """The removed fraction (0-255) of every CT voxel, kept up to date from the cut field's brick stamps.
 
-    Read on the bridge's thread: the field's queries are safe while its writer
-    cuts. A brick's fractions read its 26 neighbours' samples, so the bricks
-    around each changed one are recomputed too, a slice of bricks at a time
-    (``advance``); the image stays whole brick by brick meanwhile.
+    ``vtkVolumeCutFractionMirror`` does the work in C++ on the bridge's thread
+    and releases Python's interpreter lock meanwhile, so that the scene's
+    thread (the mouse's drilling) runs beside it; it recomputes the changed
+    bricks and their neighbours a slice at a time (``advance``).
     """
 
     def __init__(self, geometry, seq: int):
         self.field, self.dimensions, self.ijk_to_ras = geometry
         self.seq = seq
-        self.voxels = np.zeros(self.dimensions[::-1], dtype=np.uint8)
-        self.brick_dimensions = np.array(self.field.GetBrickDimensions())
-        self.voxels_per_brick = max(1, 8 // self.field.GetSubVoxelFactor())
-        self.stamp = self.field.GetCurrentStamp()
-        self._pending, self._box = [], None
-        ids, fractions = vtk.vtkIdTypeArray(), vtk.vtkFloatArray()
-        self.field.ExportRemovedVoxels(ids, fractions)
-        self._write(ids, fractions)
-
-    def _write(self, ids, fractions) -> None:
-        if ids.GetNumberOfTuples():
-            flat = self.voxels.reshape(-1)
-            flat[numpy_support.vtk_to_numpy(ids)] = np.rint(np.clip(numpy_support.vtk_to_numpy(fractions), 0.0, 1.0) * 255.0)
+        self.mirror = slicer.vtkVolumeCutFractionMirror()
+        if not self.mirror.Reset(self.field):
+            raise RuntimeError("the removed region cannot be mirrored: the cut field is not initialized")
+        image = self.mirror.GetImage()
+        # A view of the C++ image's voxels (k, j, i), valid while the mirror lives.
+        self.voxels = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(self.dimensions[::-1])
+        self._box = None
 
     @property
     def updating(self) -> bool:
-        return bool(self._pending)
+        return bool(self.mirror.IsUpdating())
+
+    @property
+    def stamp(self) -> int:
+        return self.mirror.GetStamp()
 
     def begin_update(self) -> None:
         """List the bricks to recompute: those changed since the last update and their neighbours."""
-        self._pending, self._box = [], None
-        stamp = self.field.GetCurrentStamp()
-        if stamp <= self.stamp:
-            return
-        changed = vtk.vtkIdList()
-        self.field.GetBricksModifiedSince(self.stamp, changed)
-        self.stamp = stamp
-        if changed.GetNumberOfIds() == 0:
-            return
-        ids = np.array([changed.GetId(n) for n in range(changed.GetNumberOfIds())], dtype=np.int64)
-        dims = self.brick_dimensions
-        index = np.stack([ids % dims[0], (ids // dims[0]) % dims[1], ids // (dims[0] * dims[1])], axis=1)
-        around = np.array([(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)])
-        bricks = np.unique((index[:, None, :] + around[None, :, :]).reshape(-1, 3), axis=0)
-        bricks = bricks[np.all((bricks >= 0) & (bricks < dims), axis=1)]
-        step, size = self.voxels_per_brick, np.array(self.dimensions)
-        self._box = (bricks.min(axis=0) * step, np.minimum(bricks.max(axis=0) * step + step, size))
-        self._pending = [tuple(int(v) for v in brick) for brick in bricks]
+        self._box = None
+        if self.mirror.BeginUpdate():
+            box = [0] * 6
+            self.mirror.GetUpdateBox(box)
+            self._box = (np.array(box[0::2]), np.array(box[1::2]))
 
     def advance(self, budget_s: float):
         """Recompute pending bricks for about ``budget_s``; the changed box (lower, upper: i, j, k) once all are done."""
-        deadline = time.perf_counter() + budget_s
-        dims, step, size = self.brick_dimensions, self.voxels_per_brick, np.array(self.dimensions)
-        while self._pending and time.perf_counter() < deadline:
-            i, j, k = self._pending.pop()
-            lower = np.array([i, j, k]) * step
-            upper = np.minimum(lower + step, size)
-            self.voxels[lower[2]:upper[2], lower[1]:upper[1], lower[0]:upper[0]] = 0
-            brick_id = i + int(dims[0]) * (j + int(dims[1]) * k)
-            if self.field.GetBrickStamp(brick_id):
-                removed = vtk.vtkIdTypeArray(), vtk.vtkFloatArray()
-                self.field.AppendRemovedVoxelsOfBrick(brick_id, *removed)
-                self._write(*removed)
-        return None if self._pending or self._box is None else self._box
+        if self._box is None:
+            return None
+        done = self.mirror.Advance(budget_s)
+        return self._box if done else None
 
     def pack_whole(self) -> bytes:
         return protocol.pack_image(IMAGE_DEVICE, self.voxels, self.dimensions, (0, 0, 0), self.ijk_to_ras, time.time())
