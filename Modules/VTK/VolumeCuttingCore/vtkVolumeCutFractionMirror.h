@@ -34,6 +34,7 @@
 #include "vtkSmartPointer.h" // For the field
 #include "vtkType.h"         // For vtkTypeUInt64
 #include "vtkVolumeCuttingCoreExport.h" // For export macro
+#include "vtkVolumeCutField.h"           // For BrickSize
 #include "vtkWrappingHints.h"           // For VTK_UNBLOCKTHREADS
 
 #include <vector> // For the pending bricks
@@ -45,7 +46,6 @@
 class vtkFloatArray;
 class vtkIdTypeArray;
 class vtkImageData;
-class vtkVolumeCutField;
 
 class VTK_VOLUMECUTTINGCORE_EXPORT vtkVolumeCutFractionMirror : public vtkObject
 {
@@ -110,7 +110,10 @@ protected:
   vtkTypeUInt64 Stamp = 0;
   int AnatomyDimensions[3] = { 0, 0, 0 };
   int VoxelsPerBrick = 1;
-  std::vector<vtkIdType> Pending; // anatomy voxel ids of the update
+  std::vector<vtkIdType> Pending; // anatomy voxel ids of the update, brick by brick
+  vtkIdType CopiedBrick = -1;
+  bool CopiedBrickWritten = false;
+  short Samples[vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize * vtkVolumeCutField::BrickSize] = {};
   size_t Next = 0;
   int Box[6] = { 0, 0, 0, 0, 0, 0 };
 
