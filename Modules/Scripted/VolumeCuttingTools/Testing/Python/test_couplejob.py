@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 import slicer
 
-from VolumeCuttingLib.collaboration import couplingoptions, forcecoupling
+from VolumeCuttingLib.collaboration import forcecoupling
 from VolumeCuttingLib.jobs import couplejob
 
 HOLD_MM = 3.0

@@ -60,7 +60,8 @@ def open_device(kind: str, falcon_firmware: Path | None = None, replay: Path | N
         return device
     if kind == "falcon":
         if not any(listed.kind == inputdevices.HAPTIC for listed in inputdevices.list_devices()):
-            raise CouplingError("no Novint Falcon is plugged in (or its USB device cannot be read: libusb missing, or no permission on it)")
+            raise CouplingError("no Novint Falcon is plugged in (or its USB device cannot be read: libusb missing, "
+                                "or no permission on it)")
         if falcon_firmware is None or not Path(falcon_firmware).is_file():
             raise CouplingError("the Falcon needs its firmware file, which is not shipped: give --falcon-firmware FILE "
                                 "(the file your device came with)")
