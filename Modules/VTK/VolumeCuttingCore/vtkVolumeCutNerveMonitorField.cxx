@@ -59,6 +59,163 @@ struct LevelGrid
   }
 };
 
+/// Where a voxel is outside in its slice but inside in the one beside it (an
+/// end of the structure across the slices, a floor or a roof nearly parallel
+/// to them): at most the level extrapolated from the two slices inside, and
+/// no less than the mirror of the last one, as vtkVolumeCutProtection closes
+/// the shield there (halfway to the next slice over a flat end).
+void CloseAcrossSlices(LevelGrid& grid, int sliceAxis)
+{
+  const std::vector<float> open = grid.Values;
+  const vtkIdType stride = sliceAxis == 0 ? 1 : sliceAxis == 1 ? grid.Dims[0] : static_cast<vtkIdType>(grid.Dims[0]) * grid.Dims[1];
+  for (int k = 0; k < grid.Dims[2]; ++k)
+  {
+    for (int j = 0; j < grid.Dims[1]; ++j)
+    {
+      for (int i = 0; i < grid.Dims[0]; ++i)
+      {
+        const int ijk[3] = { i, j, k };
+        const int s = ijk[sliceAxis];
+        if (s < 2 || s >= grid.Dims[sliceAxis] - 2)
+        {
+          continue;
+        }
+        const vtkIdType voxel = grid.Index(i, j, k);
+        float closed = open[voxel];
+        if (closed < 0.f)
+        {
+          continue;
+        }
+        for (const int direction : { -1, 1 })
+        {
+          const float last = open[voxel + direction * stride];
+          const float previous = open[voxel + 2 * direction * stride];
+          if (last < 0.f)
+          {
+            closed = std::min(closed, std::max(2.f * last - previous, std::abs(last)));
+          }
+        }
+        grid.Values[voxel] = closed;
+      }
+    }
+  }
+}
+
+/// Each level divided by its gradient's length (central differences, per mm)
+/// where that exceeds 1, as the shield does: across the slices the in-slice
+/// distance becomes a distance too; its zero stays.
+void NormalizeByGradient(LevelGrid& grid)
+{
+  const std::vector<float> levels = grid.Values;
+  const vtkIdType strides[3] = { 1, grid.Dims[0], static_cast<vtkIdType>(grid.Dims[0]) * grid.Dims[1] };
+  for (int k = 1; k < grid.Dims[2] - 1; ++k)
+  {
+    for (int j = 1; j < grid.Dims[1] - 1; ++j)
+    {
+      for (int i = 1; i < grid.Dims[0] - 1; ++i)
+      {
+        const vtkIdType voxel = grid.Index(i, j, k);
+        double gradient2 = 0.0;
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          const double derivative = (levels[voxel + strides[axis]] - levels[voxel - strides[axis]]) / (2.0 * grid.Spacing[axis]);
+          gradient2 += derivative * derivative;
+        }
+        grid.Values[voxel] = static_cast<float>(levels[voxel] / std::max(1.0, std::sqrt(gradient2)));
+      }
+    }
+  }
+}
+
+/// One pass of the exact squared distance from voxel centres to a union of
+/// voxel cubes along axis: out(v) = min over u on v's line of in(u) +
+/// g(v - u), g(n) = (max(|n| - 1/2, 0) s)^2. Beside v the cost is the
+/// parabola s^2 (v - u -+ 1/2)^2, so two lower envelopes of parabolas
+/// (Felzenszwalb and Huttenlocher, 2012) with vertices shifted half a voxel
+/// either way, and u = v itself, give it in linear time.
+void CubeDistancePass(std::vector<double>& values, const int dims[3], const double spacing[3], int axis)
+{
+  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  const int n = dims[axis];
+  const int a1 = axis == 0 ? 1 : 0;
+  const int a2 = axis == 2 ? 1 : 2;
+  const double s2 = spacing[axis] * spacing[axis];
+  std::vector<double> line(n), out(n), vertex(n), boundary(n + 1);
+  std::vector<int> owner(n);
+  for (int q = 0; q < dims[a2]; ++q)
+  {
+    for (int p = 0; p < dims[a1]; ++p)
+    {
+      const vtkIdType first = strides[a1] * p + strides[a2] * q;
+      for (int u = 0; u < n; ++u)
+      {
+        line[u] = values[first + strides[axis] * u];
+        out[u] = line[u];
+      }
+      for (const double shift : { 0.5, -0.5 })
+      {
+        int count = 0;
+        for (int u = 0; u < n; ++u)
+        {
+          if (!std::isfinite(line[u]))
+          {
+            continue;
+          }
+          const double c = u + shift;
+          while (count > 0)
+          {
+            const int last = owner[count - 1];
+            const double x = ((line[u] + s2 * c * c) - (line[last] + s2 * vertex[count - 1] * vertex[count - 1])) / (2.0 * s2 * (c - vertex[count - 1]));
+            if (x > boundary[count - 1])
+            {
+              boundary[count] = x;
+              break;
+            }
+            --count;
+          }
+          if (count == 0)
+          {
+            boundary[0] = -std::numeric_limits<double>::infinity();
+          }
+          owner[count] = u;
+          vertex[count] = c;
+          ++count;
+        }
+        for (int v = 0, k = 0; v < n && count > 0; ++v)
+        {
+          while (k + 1 < count && boundary[k + 1] < v)
+          {
+            ++k;
+          }
+          const double d = v - vertex[k];
+          out[v] = std::min(out[v], line[owner[k]] + s2 * d * d);
+        }
+      }
+      for (int u = 0; u < n; ++u)
+      {
+        values[first + strides[axis] * u] = out[u];
+      }
+    }
+  }
+}
+
+/// Squared distance (mm^2) from each voxel centre to the union of the cubes
+/// of the voxels whose mask is set (of = true) or clear (of = false): exact,
+/// separable over the three axes.
+void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<double>& values)
+{
+  const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  values.resize(count);
+  for (vtkIdType voxel = 0; voxel < count; ++voxel)
+  {
+    values[voxel] = (mask[voxel] != 0) == of ? 0.0 : std::numeric_limits<double>::infinity();
+  }
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    CubeDistancePass(values, dims, spacing, axis);
+  }
+}
+
 /// Surface points, and for every voxel the index of the nearest one found so far.
 struct FootPoints
 {
@@ -191,15 +348,31 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
     }
   }
 
-  // Foot points: where the zero set crosses the edges between voxel
-  // centres, and where Newton's iteration from the voxels on either side lands.
+  // The levels as the shield has them (vtkVolumeCutProtection's smoothed
+  // brick), so that the monitor's zero is the wall the cut leaves.
+  if (smoothing > 0.0)
+  {
+    CloseAcrossSlices(grid, levels.SliceAxis);
+    NormalizeByGradient(grid);
+  }
+  // The shield also keeps every voxel of the structure whole: the protected
+  // region is the smoothed interior and the voxel cubes together, whose
+  // distance outside is the smaller of the two distances.
+  std::vector<double> outsideCubes, insideCubes;
+  CubeDistances(mask, dims, spacing, true, outsideCubes);
+  CubeDistances(mask, dims, spacing, false, insideCubes);
+  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  const bool useSmoothed = smoothing > 0.0;
+  auto labelled = [&](vtkIdType voxel) { return mask[voxel] != 0; };
   FootPoints feet;
   feet.Nearest.assign(count, -1);
   feet.SquaredDistance.assign(count, std::numeric_limits<float>::infinity());
   const double maximumSpacing = std::max({ spacing[0], spacing[1], spacing[2] });
-  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   std::vector<uint8_t> besideSurface(count, 0);
-  for (int k = box[4]; k <= box[5]; ++k)
+  // Foot points on the smoothed surface: where its zero set crosses the
+  // edges between voxel centres, and where Newton's iteration from the
+  // voxels on either side lands.
+  for (int k = box[4]; useSmoothed && k <= box[5]; ++k)
   {
     for (int j = box[2]; j <= box[3]; ++j)
     {
@@ -220,6 +393,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
           {
             continue;
           }
+          besideSurface[voxel] = besideSurface[neighbour] = 1;
           const double t = g0 / (g0 - g1);
           double p[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
           p[axis] += t * spacing[axis];
@@ -228,7 +402,6 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
           feet.Offer(voxel, foot, at);
           at[axis] += spacing[axis];
           feet.Offer(neighbour, foot, at);
-          besideSurface[voxel] = besideSurface[neighbour] = 1;
         }
       }
     }
@@ -312,11 +485,12 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
             {
               const int i = std::min(bx * BrickCells + x, dims[0] - 1);
               const vtkIdType voxel = grid.Index(i, j, k);
-              const double distance = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
-              const bool in = grid.Values[voxel] <= 0.f;
-              samples[n] = static_cast<float>(in ? -distance : distance);
-              nearest = std::min(nearest, distance);
-              inside = inside || in;
+              const double cubes = labelled(voxel) ? -std::sqrt(insideCubes[voxel]) : std::sqrt(outsideCubes[voxel]);
+              const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
+              const double value = useSmoothed ? std::min(cubes, grid.Values[voxel] <= 0.f ? -smoothed : smoothed) : cubes;
+              samples[n] = static_cast<float>(value);
+              nearest = std::min(nearest, std::abs(value));
+              inside = inside || value < 0.0;
             }
           }
         }
