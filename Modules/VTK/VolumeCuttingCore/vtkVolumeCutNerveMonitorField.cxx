@@ -11,6 +11,8 @@
 
 namespace
 {
+/// The smoothed distance stored where the shield is the voxel cubes alone (no smoothing): never the nearer one.
+constexpr float NoSmoothedSurface = 1e6f;
 /// Marks in the brick directory for bricks without samples.
 constexpr int32_t FarOutside = -1;
 constexpr int32_t DeepInside = -2;
@@ -133,7 +135,7 @@ void NormalizeByGradient(LevelGrid& grid)
 /// parabola s^2 (v - u -+ 1/2)^2, so two lower envelopes of parabolas
 /// (Felzenszwalb and Huttenlocher, 2012) with vertices shifted half a voxel
 /// either way, and u = v itself, give it in linear time.
-void CubeDistancePass(std::vector<double>& values, const int dims[3], const double spacing[3], int axis)
+void CubeDistancePass(std::vector<double>& values, std::vector<int32_t>& nearest, const int dims[3], const double spacing[3], int axis)
 {
   const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   const int n = dims[axis];
@@ -142,6 +144,7 @@ void CubeDistancePass(std::vector<double>& values, const int dims[3], const doub
   const double s2 = spacing[axis] * spacing[axis];
   std::vector<double> line(n), out(n), vertex(n), boundary(n + 1);
   std::vector<int> owner(n);
+  std::vector<int32_t> lineNearest(n), outNearest(n);
   for (int q = 0; q < dims[a2]; ++q)
   {
     for (int p = 0; p < dims[a1]; ++p)
@@ -151,6 +154,8 @@ void CubeDistancePass(std::vector<double>& values, const int dims[3], const doub
       {
         line[u] = values[first + strides[axis] * u];
         out[u] = line[u];
+        lineNearest[u] = nearest[first + strides[axis] * u];
+        outNearest[u] = lineNearest[u];
       }
       for (const double shift : { 0.5, -0.5 })
       {
@@ -188,31 +193,42 @@ void CubeDistancePass(std::vector<double>& values, const int dims[3], const doub
             ++k;
           }
           const double d = v - vertex[k];
-          out[v] = std::min(out[v], line[owner[k]] + s2 * d * d);
+          const double candidate = line[owner[k]] + s2 * d * d;
+          if (candidate < out[v])
+          {
+            out[v] = candidate;
+            outNearest[v] = lineNearest[owner[k]];
+          }
         }
       }
       for (int u = 0; u < n; ++u)
       {
         values[first + strides[axis] * u] = out[u];
+        nearest[first + strides[axis] * u] = outNearest[u];
       }
     }
   }
 }
 
 /// Squared distance (mm^2) from each voxel centre to the union of the cubes
-/// of the voxels whose mask is set (of = true) or clear (of = false): exact,
-/// separable over the three axes.
-void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<double>& values)
+/// of the voxels whose mask is set (of = true) or clear (of = false), and
+/// the voxel whose cube is nearest (-1: none): exact, separable over the
+/// three axes.
+void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<double>& values,
+  std::vector<int32_t>& nearest)
 {
   const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
   values.resize(count);
+  nearest.resize(count);
   for (vtkIdType voxel = 0; voxel < count; ++voxel)
   {
-    values[voxel] = (mask[voxel] != 0) == of ? 0.0 : std::numeric_limits<double>::infinity();
+    const bool seed = (mask[voxel] != 0) == of;
+    values[voxel] = seed ? 0.0 : std::numeric_limits<double>::infinity();
+    nearest[voxel] = seed ? static_cast<int32_t>(voxel) : -1;
   }
   for (int axis = 0; axis < 3; ++axis)
   {
-    CubeDistancePass(values, dims, spacing, axis);
+    CubeDistancePass(values, nearest, dims, spacing, axis);
   }
 }
 
@@ -359,8 +375,9 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   // region is the smoothed interior and the voxel cubes together, whose
   // distance outside is the smaller of the two distances.
   std::vector<double> outsideCubes, insideCubes;
-  CubeDistances(mask, dims, spacing, true, outsideCubes);
-  CubeDistances(mask, dims, spacing, false, insideCubes);
+  std::vector<int32_t> nearestCube, nearestFree;
+  CubeDistances(mask, dims, spacing, true, outsideCubes, nearestCube);
+  CubeDistances(mask, dims, spacing, false, insideCubes, nearestFree);
   const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   const bool useSmoothed = smoothing > 0.0;
   auto labelled = [&](vtkIdType voxel) { return mask[voxel] != 0; };
@@ -466,6 +483,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   field->Directory.assign(brickCount, FarOutside);
   constexpr int samplesPerBrick = BrickSamples * BrickSamples * BrickSamples;
   std::vector<float> samples(samplesPerBrick);
+  std::vector<int32_t> sampleCubes(samplesPerBrick);
   for (int bz = 0; bz < field->BrickCounts[2]; ++bz)
   {
     for (int by = 0; by < field->BrickCounts[1]; ++by)
@@ -487,8 +505,13 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
               const vtkIdType voxel = grid.Index(i, j, k);
               const double cubes = labelled(voxel) ? -std::sqrt(insideCubes[voxel]) : std::sqrt(outsideCubes[voxel]);
               const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
-              const double value = useSmoothed ? std::min(cubes, grid.Values[voxel] <= 0.f ? -smoothed : smoothed) : cubes;
-              samples[n] = static_cast<float>(value);
+              const double smoothedSigned = grid.Values[voxel] <= 0.f ? -smoothed : smoothed;
+              const double value = useSmoothed ? std::min(cubes, smoothedSigned) : cubes;
+              // The smoothed surface's distance is interpolated; the cubes'
+              // is computed exactly at query time from the nearest cube of
+              // the structure (outside it) or of the free voxels (inside).
+              samples[n] = static_cast<float>(useSmoothed ? smoothedSigned : NoSmoothedSurface);
+              sampleCubes[n] = labelled(voxel) ? 2 * nearestFree[voxel] + 1 : 2 * nearestCube[voxel];
               nearest = std::min(nearest, std::abs(value));
               inside = inside || value < 0.0;
             }
@@ -499,6 +522,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
         {
           field->Directory[brick] = static_cast<int32_t>(field->Bricks.size() / samplesPerBrick);
           field->Bricks.insert(field->Bricks.end(), samples.begin(), samples.end());
+          field->NearestCubes.insert(field->NearestCubes.end(), sampleCubes.begin(), sampleCubes.end());
         }
         else
         {
@@ -508,6 +532,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
     }
   }
   field->Bricks.shrink_to_fit();
+  field->NearestCubes.shrink_to_fit();
   return field;
 }
 
@@ -545,7 +570,51 @@ double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
   const double x11 = s[sz + sy] + t[0] * (s[sz + sy + 1] - s[sz + sy]);
   const double y0 = x00 + t[1] * (x10 - x00);
   const double y1 = x01 + t[1] * (x11 - x01);
-  return y0 + t[2] * (y1 - y0);
+  const double smoothed = y0 + t[2] * (y1 - y0);
+  // The voxel cubes' distance bends at their edges and corners, which
+  // interpolation would miss: it is computed exactly to the cubes nearest
+  // to the cell's corners. Outside the cubes (the voxel holding the point,
+  // the nearest corner, is free): the distance to the structure's cubes
+  // nearest to the free corners; inside: minus the distance to the free
+  // cubes nearest to the structure's corners.
+  const int32_t* nearest = this->NearestCubes.data() + (s - this->Bricks.data());
+  const int ownCorner = (t[0] >= 0.5 ? 1 : 0) + (t[1] >= 0.5 ? sy : 0) + (t[2] >= 0.5 ? sz : 0);
+  const int32_t insideFlag = nearest[ownCorner] & 1;
+  double squared = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 8; ++c)
+  {
+    const int corner[3] = { c & 1, (c >> 1) & 1, (c >> 2) & 1 };
+    const int32_t reference = nearest[corner[0] + corner[1] * sy + corner[2] * sz];
+    int cubeIndex[3];
+    if (reference < 0)
+    {
+      continue; // no voxel of that side in the mask
+    }
+    if ((reference & 1) == insideFlag)
+    {
+      const int32_t cube = reference >> 1;
+      cubeIndex[0] = cube % this->Dimensions[0];
+      cubeIndex[1] = (cube / this->Dimensions[0]) % this->Dimensions[1];
+      cubeIndex[2] = cube / (this->Dimensions[0] * this->Dimensions[1]);
+    }
+    else
+    {
+      // A corner on the other side: its own voxel's cube is one of those sought.
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        cubeIndex[axis] = brick[axis] * BrickCells + cell[axis] + corner[axis];
+      }
+    }
+    double sum = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double gap = std::max(std::abs(local[axis] - cubeIndex[axis]) - 0.5, 0.0) * this->Spacing[axis];
+      sum += gap * gap;
+    }
+    squared = std::min(squared, sum);
+  }
+  const double cubes = std::sqrt(squared);
+  return std::min(smoothed, insideFlag ? -cubes : cubes);
 }
 
 //------------------------------------------------------------------------------
@@ -564,5 +633,6 @@ double vtkVolumeCutNerveMonitorField::GetFarDistance(const double ijk[3]) const
 //------------------------------------------------------------------------------
 size_t vtkVolumeCutNerveMonitorField::GetMemorySize() const
 {
-  return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float);
+  return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float) +
+    this->NearestCubes.capacity() * sizeof(int32_t);
 }
