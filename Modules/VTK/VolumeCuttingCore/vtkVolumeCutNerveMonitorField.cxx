@@ -135,20 +135,23 @@ void NormalizeByGradient(LevelGrid& grid)
 /// parabola s^2 (v - u -+ 1/2)^2, so two lower envelopes of parabolas
 /// (Felzenszwalb and Huttenlocher, 2012) with vertices shifted half a voxel
 /// either way, and u = v itself, give it in linear time.
-void CubeDistancePass(std::vector<double>& values, std::vector<int32_t>& nearest, const int dims[3], const double spacing[3], int axis)
+void CubeDistancePass(std::vector<float>& values, std::vector<int32_t>& nearest, const int dims[3], const double spacing[3], int axis)
 {
   const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   const int n = dims[axis];
   const int a1 = axis == 0 ? 1 : 0;
   const int a2 = axis == 2 ? 1 : 2;
   const double s2 = spacing[axis] * spacing[axis];
+  // Lines are independent: threads take whole lines, each with its own scratch.
+  vtkSMPTools::For(0, static_cast<vtkIdType>(dims[a1]) * dims[a2], [&](vtkIdType begin, vtkIdType end) {
   std::vector<double> line(n), out(n), vertex(n), boundary(n + 1);
   std::vector<int> owner(n);
   std::vector<int32_t> lineNearest(n), outNearest(n);
-  for (int q = 0; q < dims[a2]; ++q)
+  for (vtkIdType lineIndex = begin; lineIndex < end; ++lineIndex)
   {
-    for (int p = 0; p < dims[a1]; ++p)
     {
+      const int p = static_cast<int>(lineIndex % dims[a1]);
+      const int q = static_cast<int>(lineIndex / dims[a1]);
       const vtkIdType first = strides[a1] * p + strides[a2] * q;
       for (int u = 0; u < n; ++u)
       {
@@ -203,18 +206,19 @@ void CubeDistancePass(std::vector<double>& values, std::vector<int32_t>& nearest
       }
       for (int u = 0; u < n; ++u)
       {
-        values[first + strides[axis] * u] = out[u];
+        values[first + strides[axis] * u] = static_cast<float>(out[u]);
         nearest[first + strides[axis] * u] = outNearest[u];
       }
     }
   }
+  });
 }
 
 /// Squared distance (mm^2) from each voxel centre to the union of the cubes
 /// of the voxels whose mask is set (of = true) or clear (of = false), and
 /// the voxel whose cube is nearest (-1: none): exact, separable over the
 /// three axes.
-void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<double>& values,
+void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<float>& values,
   std::vector<int32_t>& nearest)
 {
   const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
@@ -223,13 +227,36 @@ void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing
   for (vtkIdType voxel = 0; voxel < count; ++voxel)
   {
     const bool seed = (mask[voxel] != 0) == of;
-    values[voxel] = seed ? 0.0 : std::numeric_limits<double>::infinity();
+    values[voxel] = seed ? 0.f : std::numeric_limits<float>::infinity();
     nearest[voxel] = seed ? static_cast<int32_t>(voxel) : -1;
   }
   for (int axis = 0; axis < 3; ++axis)
   {
     CubeDistancePass(values, nearest, dims, spacing, axis);
   }
+}
+
+/// A sample's nearest cube, packed as its offset from the sample (10 bits
+/// per axis, within +-511 voxels: the stored band never reaches farther)
+/// and which side it is on: no division when a query unpacks it.
+constexpr int ReferenceBits = 10;
+constexpr int32_t ReferenceMask = (1 << ReferenceBits) - 1;
+constexpr int ReferenceOffset = 1 << (ReferenceBits - 1);
+int32_t PackCubeReference(int32_t cube, int i, int j, int k, const int dims[3], bool inside)
+{
+  const int cubeIndex[3] = { cube % dims[0], (cube / dims[0]) % dims[1], cube / (dims[0] * dims[1]) };
+  const int sample[3] = { i, j, k };
+  int32_t packed = 0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const int offset = cubeIndex[axis] - sample[axis] + ReferenceOffset;
+    if (offset < 0 || offset > ReferenceMask)
+    {
+      return -1;
+    }
+    packed |= static_cast<int32_t>(offset) << (ReferenceBits * axis);
+  }
+  return 2 * packed + (inside ? 1 : 0);
 }
 
 /// Surface points, and for every voxel the index of the nearest one found so far.
@@ -374,7 +401,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   // The shield also keeps every voxel of the structure whole: the protected
   // region is the smoothed interior and the voxel cubes together, whose
   // distance outside is the smaller of the two distances.
-  std::vector<double> outsideCubes, insideCubes;
+  std::vector<float> outsideCubes, insideCubes;
   std::vector<int32_t> nearestCube, nearestFree;
   CubeDistances(mask, dims, spacing, true, outsideCubes, nearestCube);
   CubeDistances(mask, dims, spacing, false, insideCubes, nearestFree);
@@ -503,7 +530,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
             {
               const int i = std::min(bx * BrickCells + x, dims[0] - 1);
               const vtkIdType voxel = grid.Index(i, j, k);
-              const double cubes = labelled(voxel) ? -std::sqrt(insideCubes[voxel]) : std::sqrt(outsideCubes[voxel]);
+              const double cubes = labelled(voxel) ? -std::sqrt(static_cast<double>(insideCubes[voxel])) : std::sqrt(static_cast<double>(outsideCubes[voxel]));
               const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
               const double smoothedSigned = grid.Values[voxel] <= 0.f ? -smoothed : smoothed;
               const double value = useSmoothed ? std::min(cubes, smoothedSigned) : cubes;
@@ -511,7 +538,8 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
               // is computed exactly at query time from the nearest cube of
               // the structure (outside it) or of the free voxels (inside).
               samples[n] = static_cast<float>(useSmoothed ? smoothedSigned : NoSmoothedSurface);
-              sampleCubes[n] = labelled(voxel) ? 2 * nearestFree[voxel] + 1 : 2 * nearestCube[voxel];
+              const int32_t cube = labelled(voxel) ? nearestFree[voxel] : nearestCube[voxel];
+              sampleCubes[n] = cube < 0 ? -1 : PackCubeReference(cube, i, j, k, dims, labelled(voxel));
               nearest = std::min(nearest, std::abs(value));
               inside = inside || value < 0.0;
             }
@@ -592,10 +620,11 @@ double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
     }
     if ((reference & 1) == insideFlag)
     {
-      const int32_t cube = reference >> 1;
-      cubeIndex[0] = cube % this->Dimensions[0];
-      cubeIndex[1] = (cube / this->Dimensions[0]) % this->Dimensions[1];
-      cubeIndex[2] = cube / (this->Dimensions[0] * this->Dimensions[1]);
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        const int sample = std::min(brick[axis] * BrickCells + cell[axis] + corner[axis], this->Dimensions[axis] - 1);
+        cubeIndex[axis] = sample + ((reference >> (1 + ReferenceBits * axis)) & ReferenceMask) - ReferenceOffset;
+      }
     }
     else
     {

@@ -63,8 +63,8 @@ private:
   /// Brick index by brick (x fastest), -1 where nothing is within Range.
   std::vector<int32_t> Directory;
   std::vector<float> Bricks;
-  /// Per sample of Bricks: twice the mask index of the voxel whose cube is nearest, of the structure's outside it,
-  /// plus one and of the free voxels inside it.
+  /// Per sample of Bricks, the voxel whose cube is nearest (of the structure's outside it, of the free voxels
+  /// inside): its offset from the sample and the side, packed (-1: none).
   std::vector<int32_t> NearestCubes;
   size_t NumberOfFootPoints = 0;
 };
