@@ -404,7 +404,43 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   std::vector<float> outsideCubes, insideCubes;
   std::vector<int32_t> nearestCube, nearestFree;
   CubeDistances(mask, dims, spacing, true, outsideCubes, nearestCube);
-  CubeDistances(mask, dims, spacing, false, insideCubes, nearestFree);
+  // Inside, the nearest free voxel is within the structure's box grown by
+  // one voxel: the transform of the free cubes needs no more than that.
+  int freeBox[6];
+  int freeDims[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    freeBox[2 * axis] = std::max(0, labelBox[2 * axis] - 1);
+    freeBox[2 * axis + 1] = std::min(dims[axis] - 1, labelBox[2 * axis + 1] + 1);
+    freeDims[axis] = freeBox[2 * axis + 1] - freeBox[2 * axis] + 1;
+  }
+  {
+    std::vector<uint16_t> boxMask(static_cast<size_t>(freeDims[0]) * freeDims[1] * freeDims[2]);
+    for (int k = 0; k < freeDims[2]; ++k)
+    {
+      for (int j = 0; j < freeDims[1]; ++j)
+      {
+        const uint16_t* row = mask + grid.Index(freeBox[0], freeBox[2] + j, freeBox[4] + k);
+        std::copy(row, row + freeDims[0], boxMask.begin() + static_cast<size_t>(freeDims[0]) * (j + static_cast<size_t>(freeDims[1]) * k));
+      }
+    }
+    CubeDistances(boxMask.data(), freeDims, spacing, false, insideCubes, nearestFree);
+  }
+  // The free voxel nearest to a structure's voxel, as a mask index (-1 if none).
+  auto freeIndex = [&](int i, int j, int k) -> vtkIdType {
+    return (i - freeBox[0]) + static_cast<vtkIdType>(freeDims[0]) * ((j - freeBox[2]) + static_cast<vtkIdType>(freeDims[1]) * (k - freeBox[4]));
+  };
+  auto nearestFreeVoxel = [&](int i, int j, int k) -> int32_t {
+    const int32_t local = nearestFree[freeIndex(i, j, k)];
+    if (local < 0)
+    {
+      return -1;
+    }
+    const int li = local % freeDims[0];
+    const int lj = (local / freeDims[0]) % freeDims[1];
+    const int lk = local / (freeDims[0] * freeDims[1]);
+    return static_cast<int32_t>(grid.Index(li + freeBox[0], lj + freeBox[2], lk + freeBox[4]));
+  };
   const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   const bool useSmoothed = smoothing > 0.0;
   auto labelled = [&](vtkIdType voxel) { return mask[voxel] != 0; };
@@ -530,7 +566,8 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
             {
               const int i = std::min(bx * BrickCells + x, dims[0] - 1);
               const vtkIdType voxel = grid.Index(i, j, k);
-              const double cubes = labelled(voxel) ? -std::sqrt(static_cast<double>(insideCubes[voxel])) : std::sqrt(static_cast<double>(outsideCubes[voxel]));
+              const double cubes = labelled(voxel) ? -std::sqrt(static_cast<double>(insideCubes[freeIndex(i, j, k)]))
+                                                   : std::sqrt(static_cast<double>(outsideCubes[voxel]));
               const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
               const double smoothedSigned = grid.Values[voxel] <= 0.f ? -smoothed : smoothed;
               const double value = useSmoothed ? std::min(cubes, smoothedSigned) : cubes;
@@ -538,7 +575,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
               // is computed exactly at query time from the nearest cube of
               // the structure (outside it) or of the free voxels (inside).
               samples[n] = static_cast<float>(useSmoothed ? smoothedSigned : NoSmoothedSurface);
-              const int32_t cube = labelled(voxel) ? nearestFree[voxel] : nearestCube[voxel];
+              const int32_t cube = labelled(voxel) ? nearestFreeVoxel(i, j, k) : nearestCube[voxel];
               sampleCubes[n] = cube < 0 ? -1 : PackCubeReference(cube, i, j, k, dims, labelled(voxel));
               nearest = std::min(nearest, std::abs(value));
               inside = inside || value < 0.0;
