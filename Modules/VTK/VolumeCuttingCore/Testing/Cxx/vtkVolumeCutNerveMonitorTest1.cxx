@@ -62,24 +62,7 @@ struct Grid
   /// A label image with value where inside(ras) holds at the voxel centre.
   vtkSmartPointer<vtkImageData> Rasterise(const std::function<bool(const double*)>& inside, int value) const
   {
-    auto labels = vtkSmartPointer<vtkImageData>::New();
-    labels->SetDimensions(this->Dimensions[0], this->Dimensions[1], this->Dimensions[2]);
-    labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
-    unsigned short* voxel = static_cast<unsigned short*>(labels->GetScalarPointer());
-    for (int k = 0; k < this->Dimensions[2]; ++k)
-    {
-      for (int j = 0; j < this->Dimensions[1]; ++j)
-      {
-        for (int i = 0; i < this->Dimensions[0]; ++i, ++voxel)
-        {
-          const double ijk[3] = { double(i), double(j), double(k) };
-          double ras[3];
-          this->ToRAS(ijk, ras);
-          *voxel = inside(ras) ? static_cast<unsigned short>(value) : 0;
-        }
-      }
-    }
-    return labels;
+    return vtkVolumeCutNerveMonitorTesting::Rasterise(this->Dimensions, this->IJKToRAS, inside, value);
   }
 };
 

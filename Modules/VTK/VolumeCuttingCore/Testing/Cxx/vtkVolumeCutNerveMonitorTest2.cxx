@@ -37,7 +37,7 @@ struct Scene
   int Dimensions[3] = { 24, 24, 18 };
   double Spacing[3] = { 1.0, 1.0, 1.5 };
   vtkNew<vtkMatrix4x4> IJKToRAS;
-  vtkNew<vtkImageData> Labels;
+  vtkSmartPointer<vtkImageData> Labels;
   std::vector<int> Voxels; // i, j, k of the nerve's voxels
   double Centre[3];
   double Axis[3] = { 0.0, 0.0, 0.0 };
@@ -65,22 +65,8 @@ struct Scene
     {
       this->Radius = 3.0;
     }
-    this->Labels->SetDimensions(this->Dimensions);
-    this->Labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
-    unsigned short* voxel = static_cast<unsigned short*>(this->Labels->GetScalarPointer());
-    for (int k = 0; k < this->Dimensions[2]; ++k)
-    {
-      for (int j = 0; j < this->Dimensions[1]; ++j)
-      {
-        for (int i = 0; i < this->Dimensions[0]; ++i, ++voxel)
-        {
-          const double ijk[3] = { double(i), double(j), double(k) };
-          double ras[3];
-          this->ToRAS(ijk, ras);
-          *voxel = this->AnalyticDistance(ras) <= 0.0 ? 4 : 0;
-        }
-      }
-    }
+    this->Labels = vtkVolumeCutNerveMonitorTesting::Rasterise(
+      this->Dimensions, this->IJKToRAS, [this](const double* ras) { return this->AnalyticDistance(ras) <= 0.0; }, 4);
     this->Voxels = vtkVolumeCutNerveMonitorTesting::VoxelsOf(this->Labels, 4);
   }
   void ToRAS(const double ijk[3], double ras[3]) const

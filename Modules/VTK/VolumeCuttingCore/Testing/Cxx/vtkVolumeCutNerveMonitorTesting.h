@@ -7,13 +7,39 @@
 
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkSmartPointer.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 namespace vtkVolumeCutNerveMonitorTesting
 {
+/// A label image of dimensions voxels with value where inside(ras) holds at the voxel's centre.
+inline vtkSmartPointer<vtkImageData> Rasterise(const int dimensions[3], vtkMatrix4x4* ijkToRAS, const std::function<bool(const double*)>& inside, int value)
+{
+  auto labels = vtkSmartPointer<vtkImageData>::New();
+  labels->SetDimensions(dimensions[0], dimensions[1], dimensions[2]);
+  labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
+  unsigned short* voxel = static_cast<unsigned short*>(labels->GetScalarPointer());
+  for (int k = 0; k < dimensions[2]; ++k)
+  {
+    for (int j = 0; j < dimensions[1]; ++j)
+    {
+      for (int i = 0; i < dimensions[0]; ++i, ++voxel)
+      {
+        const double ijk[4] = { double(i), double(j), double(k), 1.0 };
+        double ras[4];
+        ijkToRAS->MultiplyPoint(ijk, ras);
+        *voxel = inside(ras) ? static_cast<unsigned short>(value) : 0;
+      }
+    }
+  }
+  return labels;
+}
+
 /// i, j, k of the voxels of labels (unsigned short) holding value.
 inline std::vector<int> VoxelsOf(vtkImageData* labels, int value)
 {
