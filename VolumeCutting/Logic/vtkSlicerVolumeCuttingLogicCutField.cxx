@@ -17,6 +17,7 @@
 // VolumeCutting includes
 #include "vtkMRMLVolumeCutNode.h"
 #include "vtkMRMLVolumeCutToolNode.h"
+#include "vtkSlicerVolumeCuttingNerveMonitors.h"
 #include "vtkSlicerVolumeCuttingSegmentImages.h"
 #include "vtkSlicerVolumeCuttingSegmentLayers.h"
 #include "vtkVolumeCutField.h"
@@ -209,6 +210,12 @@ void vtkSlicerVolumeCuttingLogic::UpdateProtection(vtkMRMLVolumeCutNode* cutNode
     return;
   }
   last = source.str();
+  if (this->NerveMonitoring)
+  {
+    // The monitor's fields take seconds to build (on a worker): start them
+    // with the shield, not at the first pose that reads them.
+    this->NerveMonitors->GetMonitor(cutNode);
+  }
   // Only a table of which layer values are shielded: no volume-sized work.
   vtkVolumeCutProtection* protection = field->GetProtection();
   protection->RemoveAllLabelImages();

@@ -129,7 +129,8 @@ vtkVolumeCutNerveMonitor* vtkSlicerVolumeCuttingNerveMonitors::GetMonitor(vtkMRM
   vtkNew<vtkMatrix4x4> ijkToRAS;
   anatomy->GetIJKToRASMatrix(ijkToRAS);
   vtkVolumeCutNerveMonitor* monitor = state->Monitor;
-  monitor->SetSmoothing(cutNode->GetLabelSmoothing() > 0.0 ? cutNode->GetLabelSmoothing() : 1.0);
+  // The shield's smoothing, 0 included (the voxel cubes): the monitor reads contact where the cut stops.
+  monitor->SetSmoothing(cutNode->GetLabelSmoothing());
   if (!monitor->SetGeometry(anatomy->GetImageData()->GetDimensions(), ijkToRAS))
   {
     vtkErrorMacro("GetMonitor: the scan '" << (anatomy->GetName() ? anatomy->GetName() : "") << "' cannot be monitored (see the error above)");

@@ -8,13 +8,18 @@
  * drill nears them, as facial-nerve EMG monitors make nerve irritation
  * audible in the operating room. Here each monitored structure (facial
  * nerve, chorda tympani, sigmoid sinus, ...) is a label in an integer image
- * on the anatomy's voxel grid, with a name. Its surface is the smoothed one
- * the renderer draws (vtkVolumeCutLabelSurface), so that contact is read
- * where the view shows it. Per structure, Build computes a signed distance
- * field (mm, negative inside) to that surface: foot points on the surface's
- * sub-voxel zero set, propagated to every voxel within Range of it
- * (nearest foot point, vtkVolumeCutNerveMonitorField); it is stored in
- * sparse 8^3 bricks and read by trilinear interpolation.
+ * on the anatomy's voxel grid, with a name. Its surface is where the cut
+ * stops: the shield (vtkVolumeCutProtection) keeps the structure's smoothed
+ * interior (the surface the renderer draws, vtkVolumeCutLabelSurface, closed
+ * across the slices as the shield closes it) and every one of its voxels
+ * whole, so the monitor reads contact when the burr touches either. Per
+ * structure, Build computes a signed distance field (mm, negative inside)
+ * to the union of the two, stored in sparse 8^3 bricks: the smoothed
+ * surface's distance (foot points on its sub-voxel zero set, propagated to
+ * every voxel within Range of it, vtkVolumeCutNerveMonitorField) read by
+ * trilinear interpolation, and the voxel cubes' exactly (each sample keeps
+ * its nearest cube; a query measures to the cubes of the eight samples
+ * around it, where interpolation would overshoot their edges and corners).
  *
  * A reading, per structure: the distance (mm) from the tool's surface to
  * the structure's surface (exact for the spherical burr: the field at the
@@ -158,8 +163,9 @@ public:
   ///@{
   /**
    * Set/get the in-slice Gaussian (voxels) that smooths the structures'
-   * surfaces, as the renderer's LabelSmoothing. Default 1. Takes effect for
-   * fields built afterwards.
+   * surfaces, as the renderer's LabelSmoothing and the shield's
+   * SurfaceSmoothing; 0: the voxel cubes alone, as the shield then is.
+   * Default 1. Takes effect for fields built afterwards.
    */
   vtkSetClampMacro(Smoothing, double, 0.0, 8.0);
   vtkGetMacro(Smoothing, double);

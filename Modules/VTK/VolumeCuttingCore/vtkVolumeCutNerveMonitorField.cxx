@@ -11,6 +11,8 @@
 
 namespace
 {
+/// The smoothed distance stored where the shield is the voxel cubes alone (no smoothing): never the nearer one.
+constexpr float NoSmoothedSurface = 1e6f;
 /// Marks in the brick directory for bricks without samples.
 constexpr int32_t FarOutside = -1;
 constexpr int32_t DeepInside = -2;
@@ -58,6 +60,204 @@ struct LevelGrid
     return y0 + t[2] * (y1 - y0);
   }
 };
+
+/// Where a voxel is outside in its slice but inside in the one beside it (an
+/// end of the structure across the slices, a floor or a roof nearly parallel
+/// to them): at most the level extrapolated from the two slices inside, and
+/// no less than the mirror of the last one, as vtkVolumeCutProtection closes
+/// the shield there (halfway to the next slice over a flat end).
+void CloseAcrossSlices(LevelGrid& grid, int sliceAxis)
+{
+  const std::vector<float> open = grid.Values;
+  const vtkIdType stride = sliceAxis == 0 ? 1 : sliceAxis == 1 ? grid.Dims[0] : static_cast<vtkIdType>(grid.Dims[0]) * grid.Dims[1];
+  for (int k = 0; k < grid.Dims[2]; ++k)
+  {
+    for (int j = 0; j < grid.Dims[1]; ++j)
+    {
+      for (int i = 0; i < grid.Dims[0]; ++i)
+      {
+        const int ijk[3] = { i, j, k };
+        const int s = ijk[sliceAxis];
+        if (s < 2 || s >= grid.Dims[sliceAxis] - 2)
+        {
+          continue;
+        }
+        const vtkIdType voxel = grid.Index(i, j, k);
+        float closed = open[voxel];
+        if (closed < 0.f)
+        {
+          continue;
+        }
+        for (const int direction : { -1, 1 })
+        {
+          const float last = open[voxel + direction * stride];
+          const float previous = open[voxel + 2 * direction * stride];
+          if (last < 0.f)
+          {
+            closed = std::min(closed, std::max(2.f * last - previous, std::abs(last)));
+          }
+        }
+        grid.Values[voxel] = closed;
+      }
+    }
+  }
+}
+
+/// Each level divided by its gradient's length (central differences, per mm)
+/// where that exceeds 1, as the shield does: across the slices the in-slice
+/// distance becomes a distance too; its zero stays.
+void NormalizeByGradient(LevelGrid& grid)
+{
+  const std::vector<float> levels = grid.Values;
+  const vtkIdType strides[3] = { 1, grid.Dims[0], static_cast<vtkIdType>(grid.Dims[0]) * grid.Dims[1] };
+  for (int k = 1; k < grid.Dims[2] - 1; ++k)
+  {
+    for (int j = 1; j < grid.Dims[1] - 1; ++j)
+    {
+      for (int i = 1; i < grid.Dims[0] - 1; ++i)
+      {
+        const vtkIdType voxel = grid.Index(i, j, k);
+        double gradient2 = 0.0;
+        for (int axis = 0; axis < 3; ++axis)
+        {
+          const double derivative = (levels[voxel + strides[axis]] - levels[voxel - strides[axis]]) / (2.0 * grid.Spacing[axis]);
+          gradient2 += derivative * derivative;
+        }
+        grid.Values[voxel] = static_cast<float>(levels[voxel] / std::max(1.0, std::sqrt(gradient2)));
+      }
+    }
+  }
+}
+
+/// One pass of the exact squared distance from voxel centres to a union of
+/// voxel cubes along axis: out(v) = min over u on v's line of in(u) +
+/// g(v - u), g(n) = (max(|n| - 1/2, 0) s)^2. Beside v the cost is the
+/// parabola s^2 (v - u -+ 1/2)^2, so two lower envelopes of parabolas
+/// (Felzenszwalb and Huttenlocher, 2012) with vertices shifted half a voxel
+/// either way, and u = v itself, give it in linear time.
+void CubeDistancePass(std::vector<float>& values, std::vector<int32_t>& nearest, const int dims[3], const double spacing[3], int axis)
+{
+  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  const int n = dims[axis];
+  const int a1 = axis == 0 ? 1 : 0;
+  const int a2 = axis == 2 ? 1 : 2;
+  const double s2 = spacing[axis] * spacing[axis];
+  // Lines are independent: threads take whole lines, each with its own scratch.
+  vtkSMPTools::For(0, static_cast<vtkIdType>(dims[a1]) * dims[a2], [&](vtkIdType begin, vtkIdType end) {
+  std::vector<double> line(n), out(n), vertex(n), boundary(n + 1);
+  std::vector<int> owner(n);
+  std::vector<int32_t> lineNearest(n), outNearest(n);
+  for (vtkIdType lineIndex = begin; lineIndex < end; ++lineIndex)
+  {
+    {
+      const int p = static_cast<int>(lineIndex % dims[a1]);
+      const int q = static_cast<int>(lineIndex / dims[a1]);
+      const vtkIdType first = strides[a1] * p + strides[a2] * q;
+      for (int u = 0; u < n; ++u)
+      {
+        line[u] = values[first + strides[axis] * u];
+        out[u] = line[u];
+        lineNearest[u] = nearest[first + strides[axis] * u];
+        outNearest[u] = lineNearest[u];
+      }
+      for (const double shift : { 0.5, -0.5 })
+      {
+        int count = 0;
+        for (int u = 0; u < n; ++u)
+        {
+          if (!std::isfinite(line[u]))
+          {
+            continue;
+          }
+          const double c = u + shift;
+          while (count > 0)
+          {
+            const int last = owner[count - 1];
+            const double x = ((line[u] + s2 * c * c) - (line[last] + s2 * vertex[count - 1] * vertex[count - 1])) / (2.0 * s2 * (c - vertex[count - 1]));
+            if (x > boundary[count - 1])
+            {
+              boundary[count] = x;
+              break;
+            }
+            --count;
+          }
+          if (count == 0)
+          {
+            boundary[0] = -std::numeric_limits<double>::infinity();
+          }
+          owner[count] = u;
+          vertex[count] = c;
+          ++count;
+        }
+        for (int v = 0, k = 0; v < n && count > 0; ++v)
+        {
+          while (k + 1 < count && boundary[k + 1] < v)
+          {
+            ++k;
+          }
+          const double d = v - vertex[k];
+          const double candidate = line[owner[k]] + s2 * d * d;
+          if (candidate < out[v])
+          {
+            out[v] = candidate;
+            outNearest[v] = lineNearest[owner[k]];
+          }
+        }
+      }
+      for (int u = 0; u < n; ++u)
+      {
+        values[first + strides[axis] * u] = static_cast<float>(out[u]);
+        nearest[first + strides[axis] * u] = outNearest[u];
+      }
+    }
+  }
+  });
+}
+
+/// Squared distance (mm^2) from each voxel centre to the union of the cubes
+/// of the voxels whose mask is set (of = true) or clear (of = false), and
+/// the voxel whose cube is nearest (-1: none): exact, separable over the
+/// three axes.
+void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing[3], bool of, std::vector<float>& values,
+  std::vector<int32_t>& nearest)
+{
+  const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
+  values.resize(count);
+  nearest.resize(count);
+  for (vtkIdType voxel = 0; voxel < count; ++voxel)
+  {
+    const bool seed = (mask[voxel] != 0) == of;
+    values[voxel] = seed ? 0.f : std::numeric_limits<float>::infinity();
+    nearest[voxel] = seed ? static_cast<int32_t>(voxel) : -1;
+  }
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    CubeDistancePass(values, nearest, dims, spacing, axis);
+  }
+}
+
+/// A sample's nearest cube, packed as its offset from the sample (10 bits
+/// per axis, within +-511 voxels: the stored band never reaches farther)
+/// and which side it is on: no division when a query unpacks it.
+constexpr int ReferenceBits = 10;
+constexpr int32_t ReferenceMask = (1 << ReferenceBits) - 1;
+constexpr int ReferenceOffset = 1 << (ReferenceBits - 1);
+int32_t PackCubeReference(int32_t cube, int i, int j, int k, const int dims[3], bool inside)
+{
+  const int cubeIndex[3] = { cube % dims[0], (cube / dims[0]) % dims[1], cube / (dims[0] * dims[1]) };
+  const int sample[3] = { i, j, k };
+  int32_t packed = 0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const int offset = cubeIndex[axis] - sample[axis] + ReferenceOffset;
+    if (offset < 0 || offset > ReferenceMask)
+    {
+      return -1;
+    }
+    packed |= static_cast<int32_t>(offset) << (ReferenceBits * axis);
+  }
+  return 2 * packed + (inside ? 1 : 0);
+}
 
 /// Surface points, and for every voxel the index of the nearest one found so far.
 struct FootPoints
@@ -191,15 +391,68 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
     }
   }
 
-  // Foot points: where the zero set crosses the edges between voxel
-  // centres, and where Newton's iteration from the voxels on either side lands.
+  // The levels as the shield has them (vtkVolumeCutProtection's smoothed
+  // brick), so that the monitor's zero is the wall the cut leaves.
+  if (smoothing > 0.0)
+  {
+    CloseAcrossSlices(grid, levels.SliceAxis);
+    NormalizeByGradient(grid);
+  }
+  // The shield also keeps every voxel of the structure whole: the protected
+  // region is the smoothed interior and the voxel cubes together, whose
+  // distance outside is the smaller of the two distances.
+  std::vector<float> outsideCubes, insideCubes;
+  std::vector<int32_t> nearestCube, nearestFree;
+  CubeDistances(mask, dims, spacing, true, outsideCubes, nearestCube);
+  // Inside, the nearest free voxel is within the structure's box grown by
+  // one voxel: the transform of the free cubes needs no more than that.
+  int freeBox[6];
+  int freeDims[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    freeBox[2 * axis] = std::max(0, labelBox[2 * axis] - 1);
+    freeBox[2 * axis + 1] = std::min(dims[axis] - 1, labelBox[2 * axis + 1] + 1);
+    freeDims[axis] = freeBox[2 * axis + 1] - freeBox[2 * axis] + 1;
+  }
+  {
+    std::vector<uint16_t> boxMask(static_cast<size_t>(freeDims[0]) * freeDims[1] * freeDims[2]);
+    for (int k = 0; k < freeDims[2]; ++k)
+    {
+      for (int j = 0; j < freeDims[1]; ++j)
+      {
+        const uint16_t* row = mask + grid.Index(freeBox[0], freeBox[2] + j, freeBox[4] + k);
+        std::copy(row, row + freeDims[0], boxMask.begin() + static_cast<size_t>(freeDims[0]) * (j + static_cast<size_t>(freeDims[1]) * k));
+      }
+    }
+    CubeDistances(boxMask.data(), freeDims, spacing, false, insideCubes, nearestFree);
+  }
+  // The free voxel nearest to a structure's voxel, as a mask index (-1 if none).
+  auto freeIndex = [&](int i, int j, int k) -> vtkIdType {
+    return (i - freeBox[0]) + static_cast<vtkIdType>(freeDims[0]) * ((j - freeBox[2]) + static_cast<vtkIdType>(freeDims[1]) * (k - freeBox[4]));
+  };
+  auto nearestFreeVoxel = [&](int i, int j, int k) -> int32_t {
+    const int32_t local = nearestFree[freeIndex(i, j, k)];
+    if (local < 0)
+    {
+      return -1;
+    }
+    const int li = local % freeDims[0];
+    const int lj = (local / freeDims[0]) % freeDims[1];
+    const int lk = local / (freeDims[0] * freeDims[1]);
+    return static_cast<int32_t>(grid.Index(li + freeBox[0], lj + freeBox[2], lk + freeBox[4]));
+  };
+  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
+  const bool useSmoothed = smoothing > 0.0;
+  auto labelled = [&](vtkIdType voxel) { return mask[voxel] != 0; };
   FootPoints feet;
   feet.Nearest.assign(count, -1);
   feet.SquaredDistance.assign(count, std::numeric_limits<float>::infinity());
   const double maximumSpacing = std::max({ spacing[0], spacing[1], spacing[2] });
-  const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
   std::vector<uint8_t> besideSurface(count, 0);
-  for (int k = box[4]; k <= box[5]; ++k)
+  // Foot points on the smoothed surface: where its zero set crosses the
+  // edges between voxel centres, and where Newton's iteration from the
+  // voxels on either side lands.
+  for (int k = box[4]; useSmoothed && k <= box[5]; ++k)
   {
     for (int j = box[2]; j <= box[3]; ++j)
     {
@@ -220,6 +473,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
           {
             continue;
           }
+          besideSurface[voxel] = besideSurface[neighbour] = 1;
           const double t = g0 / (g0 - g1);
           double p[3] = { i * spacing[0], j * spacing[1], k * spacing[2] };
           p[axis] += t * spacing[axis];
@@ -228,7 +482,6 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
           feet.Offer(voxel, foot, at);
           at[axis] += spacing[axis];
           feet.Offer(neighbour, foot, at);
-          besideSurface[voxel] = besideSurface[neighbour] = 1;
         }
       }
     }
@@ -293,6 +546,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   field->Directory.assign(brickCount, FarOutside);
   constexpr int samplesPerBrick = BrickSamples * BrickSamples * BrickSamples;
   std::vector<float> samples(samplesPerBrick);
+  std::vector<int32_t> sampleCubes(samplesPerBrick);
   for (int bz = 0; bz < field->BrickCounts[2]; ++bz)
   {
     for (int by = 0; by < field->BrickCounts[1]; ++by)
@@ -312,11 +566,19 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
             {
               const int i = std::min(bx * BrickCells + x, dims[0] - 1);
               const vtkIdType voxel = grid.Index(i, j, k);
-              const double distance = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
-              const bool in = grid.Values[voxel] <= 0.f;
-              samples[n] = static_cast<float>(in ? -distance : distance);
-              nearest = std::min(nearest, distance);
-              inside = inside || in;
+              const double cubes = labelled(voxel) ? -std::sqrt(static_cast<double>(insideCubes[freeIndex(i, j, k)]))
+                                                   : std::sqrt(static_cast<double>(outsideCubes[voxel]));
+              const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
+              const double smoothedSigned = grid.Values[voxel] <= 0.f ? -smoothed : smoothed;
+              const double value = useSmoothed ? std::min(cubes, smoothedSigned) : cubes;
+              // The smoothed surface's distance is interpolated; the cubes'
+              // is computed exactly at query time from the nearest cube of
+              // the structure (outside it) or of the free voxels (inside).
+              samples[n] = static_cast<float>(useSmoothed ? smoothedSigned : NoSmoothedSurface);
+              const int32_t cube = labelled(voxel) ? nearestFreeVoxel(i, j, k) : nearestCube[voxel];
+              sampleCubes[n] = cube < 0 ? -1 : PackCubeReference(cube, i, j, k, dims, labelled(voxel));
+              nearest = std::min(nearest, std::abs(value));
+              inside = inside || value < 0.0;
             }
           }
         }
@@ -325,6 +587,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
         {
           field->Directory[brick] = static_cast<int32_t>(field->Bricks.size() / samplesPerBrick);
           field->Bricks.insert(field->Bricks.end(), samples.begin(), samples.end());
+          field->NearestCubes.insert(field->NearestCubes.end(), sampleCubes.begin(), sampleCubes.end());
         }
         else
         {
@@ -334,6 +597,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
     }
   }
   field->Bricks.shrink_to_fit();
+  field->NearestCubes.shrink_to_fit();
   return field;
 }
 
@@ -371,7 +635,52 @@ double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
   const double x11 = s[sz + sy] + t[0] * (s[sz + sy + 1] - s[sz + sy]);
   const double y0 = x00 + t[1] * (x10 - x00);
   const double y1 = x01 + t[1] * (x11 - x01);
-  return y0 + t[2] * (y1 - y0);
+  const double smoothed = y0 + t[2] * (y1 - y0);
+  // The voxel cubes' distance bends at their edges and corners, which
+  // interpolation would miss: it is computed exactly to the cubes nearest
+  // to the cell's corners. Outside the cubes (the voxel holding the point,
+  // the nearest corner, is free): the distance to the structure's cubes
+  // nearest to the free corners; inside: minus the distance to the free
+  // cubes nearest to the structure's corners.
+  const int32_t* nearest = this->NearestCubes.data() + (s - this->Bricks.data());
+  const int ownCorner = (t[0] >= 0.5 ? 1 : 0) + (t[1] >= 0.5 ? sy : 0) + (t[2] >= 0.5 ? sz : 0);
+  const int32_t insideFlag = nearest[ownCorner] & 1;
+  double squared = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < 8; ++c)
+  {
+    const int corner[3] = { c & 1, (c >> 1) & 1, (c >> 2) & 1 };
+    const int32_t reference = nearest[corner[0] + corner[1] * sy + corner[2] * sz];
+    int cubeIndex[3];
+    if (reference < 0)
+    {
+      continue; // no voxel of that side in the mask
+    }
+    if ((reference & 1) == insideFlag)
+    {
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        const int sample = std::min(brick[axis] * BrickCells + cell[axis] + corner[axis], this->Dimensions[axis] - 1);
+        cubeIndex[axis] = sample + ((reference >> (1 + ReferenceBits * axis)) & ReferenceMask) - ReferenceOffset;
+      }
+    }
+    else
+    {
+      // A corner on the other side: its own voxel's cube is one of those sought.
+      for (int axis = 0; axis < 3; ++axis)
+      {
+        cubeIndex[axis] = brick[axis] * BrickCells + cell[axis] + corner[axis];
+      }
+    }
+    double sum = 0.0;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      const double gap = std::max(std::abs(local[axis] - cubeIndex[axis]) - 0.5, 0.0) * this->Spacing[axis];
+      sum += gap * gap;
+    }
+    squared = std::min(squared, sum);
+  }
+  const double cubes = std::sqrt(squared);
+  return std::min(smoothed, insideFlag ? -cubes : cubes);
 }
 
 //------------------------------------------------------------------------------
@@ -390,5 +699,6 @@ double vtkVolumeCutNerveMonitorField::GetFarDistance(const double ijk[3]) const
 //------------------------------------------------------------------------------
 size_t vtkVolumeCutNerveMonitorField::GetMemorySize() const
 {
-  return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float);
+  return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float) +
+    this->NearestCubes.capacity() * sizeof(int32_t);
 }

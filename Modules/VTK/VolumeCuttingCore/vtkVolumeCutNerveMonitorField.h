@@ -5,18 +5,23 @@
  * @class   vtkVolumeCutNerveMonitorField
  * @brief   One monitored structure's signed distance field, immutable once built.
  *
- * The structure's surface is the zero set of the trilinear interpolation of
- * its smoothed levels (vtkVolumeCutLabelSurface). Foot points on it are
- * taken where it crosses the edges between voxel centres (exact on the
- * trilinear zero set) and where Newton's iteration from each voxel next to
- * it lands (close to the voxel's orthogonal projection), so that every
- * voxel near the surface knows a surface point within a small fraction of a
- * voxel of its closest one. Each voxel's nearest foot point is then
- * propagated outwards by raster sweeps over the 26 neighbours (vector
- * propagation after Danielsson, 1980, with sub-voxel foot points instead of
- * voxel centres): the distance is the Euclidean distance to that point,
- * negative inside. Samples within Range of the surface are kept in bricks
- * of 8^3 cells whose 9^3 corners are stored together, so that a trilinear
+ * What the cut protects: the shield keeps the structure's smoothed interior
+ * and every voxel of it whole. The smoothed surface is the zero set of the
+ * trilinear interpolation of its levels (vtkVolumeCutLabelSurface, closed
+ * across the slices and divided by their gradient's length as
+ * vtkVolumeCutProtection does). Foot points on it are taken where it
+ * crosses the edges between voxel centres (exact on the trilinear zero set)
+ * and where Newton's iteration from each voxel next to it lands, and each
+ * voxel's nearest foot point is propagated outwards by raster sweeps over
+ * the 26 neighbours (vector propagation after Danielsson, 1980, with
+ * sub-voxel foot points): that distance is interpolated at query time. The
+ * voxel cubes' distance is exact: a separable transform (lower envelopes of
+ * parabolas, Felzenszwalb and Huttenlocher 2012, with vertices half a voxel
+ * off, since a cube's distance is zero across it) gives each voxel its
+ * nearest cube, of the structure outside it and of the free voxels inside,
+ * and a query measures to the cubes of the eight samples around it. The
+ * distance is the smaller of the two. Samples within Range are kept in
+ * bricks of 8^3 cells whose 9^3 corners are stored together, so that a
  * lookup reads one brick.
  */
 #ifndef vtkVolumeCutNerveMonitorField_h
@@ -63,6 +68,9 @@ private:
   /// Brick index by brick (x fastest), -1 where nothing is within Range.
   std::vector<int32_t> Directory;
   std::vector<float> Bricks;
+  /// Per sample of Bricks, the voxel whose cube is nearest (of the structure's outside it, of the free voxels
+  /// inside): its offset from the sample and the side, packed (-1: none).
+  std::vector<int32_t> NearestCubes;
   size_t NumberOfFootPoints = 0;
 };
 

@@ -97,13 +97,17 @@ def test_approaching_the_facial_nerve_lowers_its_distance_raises_its_level_and_t
     burr_radius = app.page.evaluate("() => window.trame.state.get('vc_tool').diameter") / 2.0
     own = diagnostics(app)["colours"][NERVE]
     readings = []
+    previous = "''"
     for gap in APPROACH_MM:
         point = centre + normal * (nerve_radius + burr_radius + gap)
         assert app.page.evaluate("(p) => window.trame.trigger('vc_place_tool', [p])", point.tolist()) is True
+        # The meter's reading for this pose, not the last pose's still shown (within the tolerance of both).
         app.wait_for(f"""() => {{ const r = document.querySelector('[data-monitor-of="{NERVE}"]');
-                         return r && r.dataset.mm !== '' && Math.abs(Number(r.dataset.mm) - {gap}) < {TOLERANCE_MM}; }}""",
+                         return r && r.dataset.mm !== '' && r.dataset.mm !== {previous}
+                           && Math.abs(Number(r.dataset.mm) - {gap}) < {TOLERANCE_MM}; }}""",
                      20, f"the meter to read about {gap} mm")
         readings.append((gap, meter_row(app, NERVE), diagnostics(app)))
+        previous = repr(app.page.evaluate(f"() => document.querySelector('[data-monitor-of=\"{NERVE}\"]').dataset.mm"))
     distances = [row["mm"] for _, row, _ in readings]
     assert all(b < a for a, b in zip(distances, distances[1:])), f"the distance does not fall: {distances}"
     levels = [nervemonitor.LEVEL_NAMES.index(row["level"]) for _, row, _ in readings]

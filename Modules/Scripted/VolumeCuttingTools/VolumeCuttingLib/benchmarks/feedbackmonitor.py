@@ -1,12 +1,18 @@
 """The virtual nerve monitor's figures (issue 25), for the area ``feedback``.
 
-Accuracy: an analytic nerve, a cylinder of 0.7 mm radius along an oblique
-axis, rasterised at 0.15 mm (the temporal-bone scale) into a binary label;
-burrs of 0.5, 1 and 2 mm radius at 0.05 to 3.5 mm from its surface around
-its middle. The monitor's distance (field at the burr's centre minus the
-radius) against the exact one; baseline: the distance to the label's voxel
-cubes (the stairs a monitor without the smoothed surface reads), measured
-on the same burrs in the same process.
+Accuracy: the monitor reads the distance to what the cut protects, the
+structure's smoothed interior together with its voxel cubes (the shield
+keeps every voxel of a protected structure whole). (1) An analytic nerve, a
+cylinder of 0.7 mm radius along an oblique axis, rasterised at 0.15 mm (the
+temporal-bone scale); burrs of 0.5, 1 and 2 mm radius at 0.05 to 3.5 mm from
+its surface around its middle: the monitor's distance against the exact one
+to the cylinder (the voxel stairs included: up to half a voxel's diagonal)
+and, baseline, the distance to the label's voxel cubes, measured on the same
+burrs in the same process. (2) Clinical voxels: a ball of 3 mm radius on
+1 x 1 x 1.5 mm voxels with the grid's direction flipped, monitored without
+smoothing (the shield is then the voxel cubes, known exactly): burrs placed
+0 to 2 mm from the cubes, the reading against that distance, and how often
+the level says contact wrongly a hair (0.02 mm) either side of touching.
 
 Cost: the temporal-bone case (``data.temporalbone``: 288^3 voxels of
 0.15 mm, 14 structures drawn slice by slice), 10 of its structures
@@ -106,12 +112,63 @@ def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
     voxel_centres = np.argwhere(labels[:, :, :] > 0)[:, ::-1] * CYLINDER_SPACING
     stairs = _voxel_cube_distance(np.array(centres), voxel_centres, CYLINDER_SPACING / 2) - np.array(radii)
     stairs_error = np.abs(stairs - np.array(exact))
-    where = f"cylinder nerve r {CYLINDER_RADIUS} mm at {CYLINDER_SPACING} mm voxels, {count} burrs of 0.5-2 mm at 0.05-3.5 mm"
+    where = (f"cylinder nerve r {CYLINDER_RADIUS} mm at {CYLINDER_SPACING} mm voxels, {count} burrs of 0.5-2 mm at 0.05-3.5 mm; "
+             "against the analytic cylinder, voxel stairs included")
     return [
         measurement(f"nerve monitor distance error, max ({where})", float(error.max()), "mm",
                     "distance to the label's voxel cubes, max error", float(stairs_error.max()), count, machine),
         measurement(f"nerve monitor distance error, mean ({where})", float(error.mean()), "mm",
                     "distance to the label's voxel cubes, mean error", float(stairs_error.mean()), count, machine),
+    ]
+
+
+def _clinical_voxel_accuracy(machine) -> list[dict]:
+    dims = np.array([24, 24, 18])
+    spacing = np.array([1.0, 1.0, 1.5])
+    ijk_to_ras = np.diag([-spacing[0], spacing[1], -spacing[2], 1.0])
+    ijk_to_ras[:3, 3] = [5.0, -7.0, 3.0]
+    centre = ijk_to_ras[:3, :3] @ np.array([11.8, 11.3, 8.67]) + ijk_to_ras[:3, 3]
+    k, j, i = np.meshgrid(*(np.arange(n) for n in dims[::-1]), indexing="ij")
+    ras = np.stack([i, j, k], axis=-1) @ ijk_to_ras[:3, :3].T + ijk_to_ras[:3, 3]
+    labels = (np.linalg.norm(ras - centre, axis=-1) <= 3.0).astype(np.uint16)
+    voxels = np.argwhere(labels > 0)[:, ::-1]
+    ras_to_ijk = np.linalg.inv(ijk_to_ras)
+
+    def cube_distance(point):
+        ijk = ras_to_ijk[:3, :3] @ point + ras_to_ijk[:3, 3]
+        gap = np.maximum(np.abs(voxels - ijk) - 0.5, 0.0) * spacing
+        return float(np.sqrt((gap * gap).sum(axis=1)).min())
+
+    def place(direction, distance):
+        low, high = 0.0, 20.0
+        for _ in range(50):
+            middle = 0.5 * (low + high)
+            low, high = (middle, high) if cube_distance(centre + middle * direction) < distance else (low, middle)
+        return centre + 0.5 * (low + high) * direction
+
+    monitor = slicer.vtkVolumeCutNerveMonitor()
+    monitor.SetSmoothing(0.0)
+    monitor.SetGeometry([int(n) for n in dims], _matrix(ijk_to_ras))
+    monitor.AddStructure("ball nerve", _label_image(labels), 1)
+    monitor.Build()
+    rng = np.random.default_rng(7)
+    errors, wrong = [], 0
+    for q in range(60):
+        direction = rng.normal(size=3)
+        direction /= np.linalg.norm(direction)
+        burr = BURR_RADII[q % len(BURR_RADII)]
+        distance = (0.0, 0.25, 0.5, 1.0, 2.0)[q % 5]
+        monitor.UpdateWithBurr([float(v) for v in place(direction, burr + distance)], burr)
+        errors.append(abs(monitor.GetDistance(0) - distance))
+        for offset, contact in ((-0.02, True), (0.02, False)):
+            monitor.UpdateWithBurr([float(v) for v in place(direction, burr + offset)], burr)
+            wrong += (monitor.GetLevel(0) == slicer.vtkVolumeCutNerveMonitor.Contact) != contact
+    where = "ball r 3 mm at 1 x 1 x 1.5 mm voxels, IJK-to-RAS flipped, 60 burrs at 0-2 mm from its voxel cubes"
+    return [
+        measurement(f"nerve monitor distance error against the shield's voxel cubes, max ({where})", float(np.max(errors)), "mm",
+                    "a tenth of the voxel", 0.1, len(errors), machine),
+        measurement(f"nerve monitor contact level wrong 0.02 mm either side of touching ({where})", float(wrong), "readings",
+                    "readings checked", 2.0 * len(errors), len(errors), machine),
     ]
 
 
@@ -189,4 +246,4 @@ def _temporal_bone_cost(machine) -> list[dict]:
 def monitor_measurements(repeats: int) -> list[dict]:
     """The monitor's accuracy against an analytic nerve and its cost per tick on the temporal-bone case."""
     machine = machine_description()
-    return _cylinder_accuracy(machine, repeats) + _temporal_bone_cost(machine)
+    return _cylinder_accuracy(machine, repeats) + _clinical_voxel_accuracy(machine) + _temporal_bone_cost(machine)

@@ -4,6 +4,7 @@
 #include "vtkVolumeCutEllipsoidTool.h"
 #include "vtkVolumeCutLabelSurface.h"
 #include "vtkVolumeCutNerveMonitor.h"
+#include "vtkVolumeCutNerveMonitorTesting.h"
 
 #include <vtkAddonTestingMacros.h>
 #include <vtkTestingOutputWindow.h>
@@ -61,24 +62,7 @@ struct Grid
   /// A label image with value where inside(ras) holds at the voxel centre.
   vtkSmartPointer<vtkImageData> Rasterise(const std::function<bool(const double*)>& inside, int value) const
   {
-    auto labels = vtkSmartPointer<vtkImageData>::New();
-    labels->SetDimensions(this->Dimensions[0], this->Dimensions[1], this->Dimensions[2]);
-    labels->AllocateScalars(VTK_UNSIGNED_SHORT, 1);
-    unsigned short* voxel = static_cast<unsigned short*>(labels->GetScalarPointer());
-    for (int k = 0; k < this->Dimensions[2]; ++k)
-    {
-      for (int j = 0; j < this->Dimensions[1]; ++j)
-      {
-        for (int i = 0; i < this->Dimensions[0]; ++i, ++voxel)
-        {
-          const double ijk[3] = { double(i), double(j), double(k) };
-          double ras[3];
-          this->ToRAS(ijk, ras);
-          *voxel = inside(ras) ? static_cast<unsigned short>(value) : 0;
-        }
-      }
-    }
-    return labels;
+    return vtkVolumeCutNerveMonitorTesting::Rasterise(this->Dimensions, this->IJKToRAS, inside, value);
   }
 };
 
@@ -265,22 +249,21 @@ int TestCylinderAccuracy()
     double Spacing[3];
     double Turn;
     double Radius;
-    double Bound;
   };
-  // Temporal-bone voxels (0.15 mm), straight and oblique grids: within the
-  // issue's 0.05 mm. On anisotropic voxels the smoothed surface drawn from
-  // the binary label itself departs further from the cylinder (a quarter of
-  // the slice spacing): the field's own error is tested against that surface
-  // (TestSphereAccuracyAndTools).
-  const Case cases[] = { { { 0.15, 0.15, 0.15 }, 0.0, 0.8, 0.05 }, { { 0.15, 0.15, 0.15 }, 33.0, 0.6, 0.05 },
-    { { 0.12, 0.15, 0.25 }, 20.0, 1.0, 0.0625 }, { { 0.2, 0.2, 0.4 }, 0.0, 1.5, 0.1 } };
+  // The monitor reads the shield the cut respects, which keeps the nerve's
+  // voxel cubes whole: against the analytic cylinder its reading departs by
+  // up to the cubes' stairs, half a voxel's diagonal (0.13 mm at 0.15 mm
+  // voxels); vtkVolumeCutNerveMonitorTest2 checks it against the shield.
+  const Case cases[] = { { { 0.15, 0.15, 0.15 }, 0.0, 0.8 }, { { 0.15, 0.15, 0.15 }, 33.0, 0.6 }, { { 0.12, 0.15, 0.25 }, 20.0, 1.0 },
+    { { 0.2, 0.2, 0.4 }, 0.0, 1.5 } };
   for (const Case& c : cases)
   {
     double worstAt = 0.0;
     const double error = CylinderError(c.Spacing, c.Turn, c.Radius, 360, worstAt);
     std::cout << "cylinder radius " << c.Radius << " mm, spacing " << c.Spacing[0] << " x " << c.Spacing[1] << " x " << c.Spacing[2]
               << " mm, grid turned " << c.Turn << " degrees: max error " << error << " mm (at " << worstAt << " mm)" << std::endl;
-    CHECK_BOOL(error <= c.Bound, true);
+    const double halfDiagonal = 0.5 * std::sqrt(c.Spacing[0] * c.Spacing[0] + c.Spacing[1] * c.Spacing[1] + c.Spacing[2] * c.Spacing[2]);
+    CHECK_BOOL(error <= halfDiagonal, true);
   }
   return EXIT_SUCCESS;
 }
@@ -323,11 +306,15 @@ int TestSphereAccuracyAndTools()
     worst = std::max(worst, std::abs(reading.Distance - distance));
   }
   std::cout << "sphere radius 1.5 mm, spacing 0.15 x 0.18 x 0.22 mm: max error " << worst << " mm" << std::endl;
-  // From voxels this size the smoothed surface itself departs from the
-  // sphere by up to about 0.06 mm (in-slice Gaussian and slice interpolation);
-  // against that surface, found independently, the field is far closer.
-  CHECK_BOOL(worst <= 0.075, true);
+  // The monitor reads the shield the cut respects: the smoothed interior and
+  // the sphere's voxel cubes together, and the cubes stand out of the sphere
+  // by up to half a voxel's diagonal (0.16 mm here). Against that region,
+  // found independently (the smoothed surface's points and the exact
+  // distance to the cubes), the field is far closer.
+  const double halfDiagonal = 0.5 * std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
+  CHECK_BOOL(worst <= halfDiagonal, true);
   const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 6);
+  const std::vector<int> voxels = vtkVolumeCutNerveMonitorTesting::VoxelsOf(labels, 3);
   double worstOwn = 0.0;
   for (int n = 0; n < 120; ++n)
   {
@@ -341,9 +328,10 @@ int TestSphereAccuracyAndTools()
       p[axis] = centre[axis] + (radius + burr + distance) * direction[axis];
     }
     monitor->Measure(p, burr, &reading, 1);
-    worstOwn = std::max(worstOwn, std::abs(reading.Distance - (NearestDistance(surface, p) - burr)));
+    const double shield = std::min(NearestDistance(surface, p), vtkVolumeCutNerveMonitorTesting::VoxelCubeDistance(grid.IJKToRAS, voxels, p));
+    worstOwn = std::max(worstOwn, std::abs(reading.Distance - (shield - burr)));
   }
-  std::cout << "against the smoothed surface itself (" << surface.size() / 3 << " points): max error " << worstOwn << " mm" << std::endl;
+  std::cout << "against the smoothed surface and the voxel cubes (" << surface.size() / 3 << " points): max error " << worstOwn << " mm" << std::endl;
   CHECK_BOOL(worstOwn <= 0.02, true);
 
   // Any tool: a sphere given as an ellipsoid reads as the burr does; a
@@ -385,7 +373,7 @@ int TestSphereAccuracyAndTools()
   std::cout << "tools on " << monitor->GetNumberOfToolSamples() << " surface points: ellipsoid ball against the burr max difference " << worstBall
             << " mm, cylinder burr " << worstCylinder << " mm" << std::endl;
   CHECK_BOOL(worstBall <= 0.025, true); // points 0.2 mm apart on the ball
-  CHECK_BOOL(worstCylinder <= 0.08, true);
+  CHECK_BOOL(worstCylinder <= 0.02 + halfDiagonal, true); // against the analytic sphere: the cubes' half diagonal again
   return EXIT_SUCCESS;
 }
 
