@@ -11,6 +11,7 @@
 #include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
 #include "vtkVolumeCutField.h"
+#include "vtkVolumeCutProtection.h"
 #include "vtkVolumeCutTool.h"
 
 #include <algorithm>
@@ -97,6 +98,14 @@ struct vtkHapticForceModel::Internals
   double PreviousProxy[3] = { 0.0, 0.0, 0.0 };
   double RelativeVelocity[3] = { 0.0, 0.0, 0.0 };
   vtkHapticForceModel::Result Last = {};
+  /// Pending cuts (AddPendingCut): p0 and p1, six values a cut.
+  double Pending[vtkHapticForceModel::MaximumPendingCuts][6];
+  int PendingCount = 0;
+  /// Those near the proxy in this Update: p0, p1 - p0 and 1 / |p1 - p0|^2 (0 for a point).
+  double Near[vtkHapticForceModel::MaximumPendingCuts][7];
+  int NearCount = 0;
+  /// Whether the cut field shields structures (a pending cut keeps their voxels), for this Update.
+  bool Shielded = false;
 };
 
 //------------------------------------------------------------------------------
@@ -325,7 +334,7 @@ bool vtkHapticForceModel::IsSolid(const double ras[3]) const
 }
 
 //------------------------------------------------------------------------------
-void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool withCut) const
+void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool withCut, bool pending) const
 {
   const Internals& internal = *this->Internal;
   margins.Anatomy = -1.0;
@@ -345,10 +354,78 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
   margins.InBox = true;
   margins.Anatomy = internal.Interpolate(internal.Scalars, internal.Dimensions, ijk) - this->SurfaceIsoValue;
   // The cut field costs several times the CT's lookup: only where the CT is solid.
-  if (withCut && this->CutField && !(margins.Anatomy < 0.0))
+  if (withCut && (this->CutField || pending) && !(margins.Anatomy < 0.0))
   {
-    margins.Removal = this->CutField->GetSignedDistance(ras);
+    margins.Removal = this->RemovalDistance(ras, pending);
   }
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticForceModel::RemovalDistance(const double ras[3], bool pending) const
+{
+  const Internals& internal = *this->Internal;
+  double removal = this->CutField ? this->CutField->GetSignedDistance(ras) : VTK_DOUBLE_MAX;
+  if (!pending)
+  {
+    return removal;
+  }
+  // The union of the removed region and the pending capsules: the smaller
+  // distance, as the field will hold once the cutter has cut them.
+  double nearest = VTK_DOUBLE_MAX;
+  for (int n = 0; n < internal.NearCount; ++n)
+  {
+    const double* cut = internal.Near[n];
+    const double w[3] = { ras[0] - cut[0], ras[1] - cut[1], ras[2] - cut[2] };
+    const double along = std::min(std::max((w[0] * cut[3] + w[1] * cut[4] + w[2] * cut[5]) * cut[6], 0.0), 1.0);
+    const double d[3] = { w[0] - along * cut[3], w[1] - along * cut[4], w[2] - along * cut[5] };
+    nearest = std::min(nearest, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  }
+  const double capsule = std::sqrt(nearest) - this->SphereRadius;
+  if (!(capsule < removal))
+  {
+    return removal;
+  }
+  if (internal.Shielded)
+  {
+    // The cutter keeps shielded voxels: a pending cut removes nothing there.
+    int voxel[3];
+    for (int row = 0; row < 3; ++row)
+    {
+      voxel[row] = static_cast<int>(std::lround(internal.RASToIJK[row][0] * ras[0] + internal.RASToIJK[row][1] * ras[1] +
+        internal.RASToIJK[row][2] * ras[2] + internal.RASToIJK[row][3]));
+    }
+    if (this->CutField->GetProtection()->GetShieldLabel(voxel[0], voxel[1], voxel[2]) != 0)
+    {
+      return removal;
+    }
+  }
+  return capsule;
+}
+
+//------------------------------------------------------------------------------
+void vtkHapticForceModel::ClearPendingCuts()
+{
+  this->Internal->PendingCount = 0;
+}
+
+//------------------------------------------------------------------------------
+bool vtkHapticForceModel::AddPendingCut(const double p0[3], const double p1[3])
+{
+  Internals& internal = *this->Internal;
+  if (this->Tool || internal.PendingCount >= MaximumPendingCuts || !p0 || !p1 || !std::isfinite(p0[0] + p0[1] + p0[2] + p1[0] + p1[1] + p1[2]))
+  {
+    return false;
+  }
+  double* cut = internal.Pending[internal.PendingCount++];
+  std::copy(p0, p0 + 3, cut);
+  std::copy(p1, p1 + 3, cut + 3);
+  return true;
+}
+
+//------------------------------------------------------------------------------
+int vtkHapticForceModel::GetNumberOfPendingCuts() const
+{
+  return this->Internal->PendingCount;
 }
 
 namespace
@@ -402,13 +479,15 @@ double FindBorder(Margin&& margin, double a, double marginA, double b, double ma
 } // namespace
 
 //------------------------------------------------------------------------------
-double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart) const
+double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples, bool pending) const
 {
   const double step = this->Internal->TraceStep;
   // 1/256 of a step (a step is half a voxel): far inside the 0.1 voxel the
   // force must agree with the picture.
   const double tolerance = step / 256.0;
-  auto at = [p, u](double s, double point[3]) {
+  // Every point the trace places is looked up: counting them counts its work.
+  auto at = [p, u, &samples](double s, double point[3]) {
+    ++samples;
     for (int axis = 0; axis < 3; ++axis)
     {
       point[axis] = p[axis] + s * u[axis];
@@ -420,7 +499,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
   // material and only the CT is sampled. Just beyond its value is where a
   // trace facing the cut surface leaves (as in the burr's own cavity): the
   // first sample there brackets that border with one lookup.
-  const bool cut = this->CutField != nullptr;
+  const bool cut = this->CutField != nullptr || pending;
   const double cutFree = cut ? 0.9 * atStart.Removal : VTK_DOUBLE_MAX;
   const double guess = cut ? std::max(1.05 * atStart.Removal + tolerance, tolerance) : VTK_DOUBLE_MAX;
   double inside = 0.0;
@@ -433,7 +512,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
     double q[3];
     at(t, q);
     Margins here;
-    this->Measure(q, here, t >= cutFree);
+    this->Measure(q, here, t >= cutFree, pending);
     if (!here.IsSolid())
     {
       if (!here.InBox)
@@ -446,7 +525,9 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
           const double middle = 0.5 * (inside + outside);
           double m[3];
           at(middle, m);
-          (this->IsSolid(m) ? inside : outside) = middle;
+          Margins margins;
+          this->Measure(m, margins, true, pending);
+          (margins.IsSolid() ? inside : outside) = middle;
         }
         return 0.5 * (inside + outside);
       }
@@ -469,7 +550,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         // The cut may end the material before the CT does.
         double m[3];
         at(exit - tolerance, m);
-        here.Removal = this->CutField->GetSignedDistance(m);
+        here.Removal = this->RemovalDistance(m, pending);
         if (!(here.Removal < 0.0))
         {
           return exit;
@@ -484,7 +565,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         [&](double s) {
           double m[3];
           at(s, m);
-          return this->CutField->GetSignedDistance(m);
+          return this->RemovalDistance(m, pending);
         },
         measured, measuredRemoval, end, here.Removal, tolerance);
     }
@@ -506,8 +587,10 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
 }
 
 //------------------------------------------------------------------------------
-int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3], bool record) const
+int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3], bool record, ContactWork* work) const
 {
+  int looked = 0;
+  double deepest = 0.0;
   const Internals& internal = *this->Internal;
   // Only the haptic thread's Update records: ComputeContactForce stays a pure read.
   Internals* recording = record ? this->Internal : nullptr;
@@ -517,6 +600,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
   {
     recording->NumberOfClearances = 0;
   }
+  const bool pending = recording && internal.NearCount > 0;
   for (int n = 0; n < internal.ShellCount; ++n)
   {
     const double* local = &internal.Shell[3 * n];
@@ -527,7 +611,8 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
     }
     const double p[3] = { position[0] + offset[0], position[1] + offset[1], position[2] + offset[2] };
     Margins margins;
-    this->Measure(p, margins);
+    this->Measure(p, margins, true, pending);
+    ++looked;
     if (!margins.IsSolid())
     {
       // A point in the cut is at least the cut field's distance from the
@@ -548,7 +633,8 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
       continue;
     }
     const double u[3] = { -offset[0] / length, -offset[1] / length, -offset[2] / length };
-    const double depth = this->ExitDistance(p, u, length, margins);
+    const double depth = this->ExitDistance(p, u, length, margins, looked, pending);
+    deepest = std::max(deepest, depth);
     for (int axis = 0; axis < 3; ++axis)
     {
       force[axis] += this->ContactStiffness * depth * u[axis];
@@ -558,6 +644,11 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
       std::copy(u, u + 3, &recording->ContactDirections[3 * contacts]);
     }
     ++contacts;
+  }
+  if (work)
+  {
+    work->Samples += looked;
+    work->Deepest = deepest;
   }
   return contacts;
 }
@@ -616,6 +707,35 @@ void vtkHapticForceModel::Update(const double position[3], const double rotation
   }
   const double dt = (timeStep > 0.0 && std::isfinite(timeStep)) ? timeStep : 1e-3;
 
+  // The pending cuts this tick's contact tests can reach: the shell's points
+  // lie within the radius of the proxy, which moves at most ProxyIterations
+  // steps.
+  internal.NearCount = 0;
+  internal.Shielded = false;
+  if (internal.PendingCount > 0)
+  {
+    const double reach = 2.0 * this->SphereRadius + this->ProxyIterations * internal.ProxyStep;
+    for (int n = 0; n < internal.PendingCount; ++n)
+    {
+      const double* p0 = internal.Pending[n];
+      const double* p1 = p0 + 3;
+      double* near = internal.Near[internal.NearCount];
+      const double d[3] = { p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2] };
+      const double length2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      const double w[3] = { internal.Proxy[0] - p0[0], internal.Proxy[1] - p0[1], internal.Proxy[2] - p0[2] };
+      const double along = length2 > 0.0 ? std::min(std::max(vtkMath::Dot(w, d) / length2, 0.0), 1.0) : 0.0;
+      const double gap[3] = { w[0] - along * d[0], w[1] - along * d[1], w[2] - along * d[2] };
+      if (vtkMath::Dot(gap, gap) <= reach * reach)
+      {
+        std::copy(p0, p0 + 3, near);
+        std::copy(d, d + 3, near + 3);
+        near[6] = length2 > 0.0 ? 1.0 / length2 : 0.0;
+        ++internal.NearCount;
+      }
+    }
+    internal.Shielded = internal.NearCount > 0 && this->CutField && this->CutField->GetProtection()->HasShieldedLabels();
+  }
+
   // Proxy: toward the hand until the coupling balances the contacts.
   double* x = internal.Proxy;
   const double k = this->CouplingStiffness;
@@ -623,7 +743,10 @@ void vtkHapticForceModel::Update(const double position[3], const double rotation
   int contacts = 0;
   for (int iteration = 0; iteration < this->ProxyIterations; ++iteration)
   {
-    contacts = this->Contact(x, rotation, contact, true);
+    ContactWork work;
+    contacts = this->Contact(x, rotation, contact, true, &work);
+    result.NumberOfSamples += work.Samples;
+    result.Immersion = work.Deepest;
     ++result.NumberOfProxySteps;
     double move[3];
     this->ProxyMove(x, position, contacts, contact, move);

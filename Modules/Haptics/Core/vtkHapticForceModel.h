@@ -232,6 +232,26 @@ public:
   vtkGetMacro(MaximumVibrationFrequency, double);
   ///@}
 
+  ///@{
+  /**
+   * Cuts made for the tool but not yet in the cut field: the haptic loop's
+   * cutter thread cuts the segments the ticks queue a moment later (see
+   * vtkHapticLoop::AsynchronousCutting). Update treats the spherical burr's
+   * capsules from p0 to p1 (centres, RAS; SphereRadius) as removed already,
+   * except in shielded anatomy voxels, which the cutter will keep: the
+   * proxy then feels the bone as the tick that cut it left it, as if it had
+   * cut it itself, not the bone the cutter has not reached yet. The capsule
+   * is the burr's exact sweep; other tools' pending sweeps are not known here
+   * (AddPendingCut refuses them, returning false). At most
+   * MaximumPendingCuts; a further one is refused. Haptic thread, between
+   * Updates; IsSolid and ComputeContactForce never count them.
+   */
+  static constexpr int MaximumPendingCuts = 64;
+  void ClearPendingCuts();
+  bool AddPendingCut(const double p0[3], const double p1[3]);
+  int GetNumberOfPendingCuts() const;
+  ///@}
+
   /**
    * Check the inputs and build the shell and lookups. False, with an error
    * naming what is missing or wrong, if the anatomy or tool cannot be used.
@@ -259,6 +279,11 @@ public:
     double Vibration;
     /// Contact tests the proxy took this tick (at most ProxyIterations).
     int NumberOfProxySteps;
+    /// Points of the anatomy the tick's contact tests looked up (CT and
+    /// cut field), traces included: what the tick's work grows with.
+    int NumberOfSamples;
+    /// The deepest shell point's depth in material (mm) at the last contact test.
+    double Immersion;
   };
 
   /**
@@ -309,9 +334,15 @@ protected:
   /**
    * Penalty force of the shell at a pose; returns the number of contacts.
    * With record, keeps the contacts' push directions and the clearances of
-   * the points in the cut for the proxy's step (Update only: the haptic thread's).
+   * the points in the cut for the proxy's step (Update only: the haptic thread's);
+   * with work, adds the points it looked up and gives the deepest contact.
    */
-  int Contact(const double position[3], const double rotation[3][3], double force[3], bool record = false) const;
+  struct ContactWork
+  {
+    int Samples = 0;
+    double Deepest = 0.0;
+  };
+  int Contact(const double position[3], const double rotation[3][3], double force[3], bool record = false, ContactWork* work = nullptr) const;
   /// The proxy's step toward the hand against the last recorded contact test.
   void ProxyMove(const double proxy[3], const double hand[3], int contacts, const double contact[3], double move[3]) const;
   /// What makes a point solid: the CT above the iso-value and the cut
@@ -323,10 +354,14 @@ protected:
     bool InBox;      ///< inside the CT's box
     bool IsSolid() const { return this->InBox && !(this->Anatomy < 0.0) && !(this->Removal < 0.0); }
   };
-  /// withCut false leaves the cut field out (Removal stays the largest double).
-  void Measure(const double ras[3], Margins& margins, bool withCut = true) const;
-  /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length.
-  double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart) const;
+  /// withCut false leaves the cut field out (Removal stays the largest double);
+  /// pending counts the pending cuts near the proxy (Update only).
+  void Measure(const double ras[3], Margins& margins, bool withCut = true, bool pending = false) const;
+  /// The cut field's signed distance at a RAS point, with pending the pending cuts near the proxy counted as removed.
+  double RemovalDistance(const double ras[3], bool pending) const;
+  /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length;
+  /// adds the points it looked up to samples.
+  double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples, bool pending) const;
 
   vtkSmartPointer<vtkImageData> Anatomy;
   vtkSmartPointer<vtkMatrix4x4> AnatomyIJKToRAS;

@@ -6,6 +6,7 @@
 #include "vtkHapticDeviceCapabilities.h"
 #include "vtkHapticForceModel.h"
 #include "vtkHapticLatestValue.h"
+#include "vtkHapticPendingCuts.h"
 #include "vtkHapticRecorder.h"
 #include "vtkHapticRing.h"
 
@@ -73,6 +74,8 @@ struct CutRequest
 {
   int Type;
   unsigned long long Tick;
+  /// A segment's place among the segments queued since Start (1, 2, ...), 0 for a stroke's beginning or end.
+  unsigned long long Sequence;
   /// When the tick queued it (the clock's count), for the cut's latency.
   Clock::rep Queued;
   double P0[3];
@@ -220,6 +223,13 @@ struct vtkHapticLoop::Internals
   std::vector<unsigned short> ShieldBuilds;
   std::vector<unsigned short> PageFaults;
   std::vector<unsigned short> Preemptions;
+  /// The force model's work in the kept ticks (see ProfileContacts).
+  struct ModelWork
+  {
+    int Contacts, ProxySteps, Samples;
+    float Immersion;
+  };
+  std::vector<ModelWork> Work;
   unsigned long long ShieldBricksInTicks = 0;
 
   // The cutter thread (see Cutting in the header).
@@ -234,6 +244,11 @@ struct vtkHapticLoop::Internals
   std::atomic<double> CutterContactDepth{ 0.0 };
   /// A stroke's beginning or end that did not fit the queue: Stop closes the field's stroke.
   bool StrokeRequestLost = false;
+  /// The segments queued and not cut yet, for the force model (FeelPendingCuts).
+  vtkHapticPendingCuts Pending;
+  /// RunTicks with ReplayCutterDelay: the first queued request not cut yet, taken off the queue.
+  bool HoldingRequest = false;
+  CutRequest HeldRequest{};
   // Cutter's statistics, read once it has stopped.
   std::vector<float> CutterDurations;
   unsigned long long CutterTimed = 0;
@@ -291,6 +306,7 @@ struct vtkHapticLoop::Internals
     request.Type = type;
     request.Tick = tick;
     request.Queued = Clock::now().time_since_epoch().count();
+    request.Sequence = type == SegmentRequest ? this->Pending.GetNextSequence() : 0;
     if (p0 && p1 && r0 && r1)
     {
       std::copy(p0, p0 + 3, request.P0);
@@ -298,7 +314,29 @@ struct vtkHapticLoop::Internals
       std::copy(&r0[0][0], &r0[0][0] + 9, &request.R0[0][0]);
       std::copy(&r1[0][0], &r1[0][0] + 9, &request.R1[0][0]);
     }
-    return this->CutRequests.Push(request);
+    if (!this->CutRequests.Push(request))
+    {
+      return false;
+    }
+    if (type == SegmentRequest)
+    {
+      this->Pending.Add(request.Sequence, request.P0, request.P1);
+    }
+    return true;
+  }
+
+  /// RunTicks' cutter (ReplayCutterDelay): cut the requests the ticks before until queued, in order.
+  void CutRequestsQueuedBefore(unsigned long long until)
+  {
+    while (this->HoldingRequest || this->CutRequests.Pop(this->HeldRequest))
+    {
+      this->HoldingRequest = this->HeldRequest.Tick >= until;
+      if (this->HoldingRequest)
+      {
+        return;
+      }
+      this->ApplyCutRequest(this->HeldRequest);
+    }
   }
 
   /// Haptic thread: the drill starts or stops, in the tick or through the cutter.
@@ -325,6 +363,8 @@ struct vtkHapticLoop::Internals
     }
     const Clock::time_point start = Clock::now();
     const bool cut = this->CutSegment(request.P0, request.P1, request.R0, request.R1);
+    // The field holds the segment: the force model need not count it any longer.
+    this->Pending.MarkCut(request.Sequence);
     const Clock::time_point end = Clock::now();
     this->CutterDurations[this->CutterTimed % this->CutterDurations.size()] = std::chrono::duration<float, std::micro>(end - start).count();
     ++this->CutterTimed;
@@ -662,12 +702,16 @@ bool vtkHapticLoop::Prepare()
   internal.ShieldBuilds.assign(capacity, 0);
   internal.PageFaults.assign(capacity, 0);
   internal.Preemptions.assign(capacity, 0);
+  internal.Work.assign(capacity, Internals::ModelWork{});
   internal.ShieldBricksInTicks = 0;
   internal.CutterDurations.assign(capacity, 0.0f);
   internal.CutterTimed = 0;
   internal.MaximumCutLatency = 0.0f;
   internal.CutInTicks = true;
   internal.StrokeRequestLost = false;
+  internal.Pending.Reset();
+  internal.HoldingRequest = false;
+  internal.Model->ClearPendingCuts();
   internal.CutterContactDepth = internal.Field ? internal.Field->GetMaximumContactDepth() : 0.0;
   internal.Timed = 0;
   internal.Jittered = 0;
@@ -763,6 +807,8 @@ void vtkHapticLoop::Stop()
   else if (internal.Prepared)
   {
     this->Finish();
+    // RunTicks' delayed cutter cuts what the ticks queued (the stroke's end too); cutting in the ticks queued nothing.
+    internal.CutRequestsQueuedBefore(~0ull);
   }
   // The haptic thread has queued its last cuts (and the stroke's end): the cutter cuts them all, then stops.
   if (internal.Cutter.joinable())
@@ -787,13 +833,23 @@ bool vtkHapticLoop::RunTicks(int count)
     vtkErrorMacro("RunTicks: the loop's thread is running; stop it first");
     return false;
   }
-  if (!internal.Prepared && !this->Prepare())
+  if (!internal.Prepared)
   {
-    return false;
+    if (!this->Prepare())
+    {
+      return false;
+    }
+    internal.CutInTicks = !(this->AsynchronousCutting && this->ReplayCutterDelay > 0 && internal.Field);
   }
   const double timeStep = 1.0 / this->Rate;
   for (int n = 0; n < count; ++n)
   {
+    if (!internal.CutInTicks)
+    {
+      // The cutter of a replay: before this tick, it cuts what the ticks up to ReplayCutterDelay ticks ago queued.
+      const unsigned long long tick = internal.TickCount.load(std::memory_order_relaxed) + 1;
+      internal.CutRequestsQueuedBefore(tick > static_cast<unsigned long long>(this->ReplayCutterDelay) ? tick - this->ReplayCutterDelay : 0);
+    }
     const Clock::time_point start = Clock::now();
     const ThreadCounters countersBefore = ReadThreadCounters();
     const double processorStart = ThreadProcessorMicroseconds();
@@ -960,6 +1016,7 @@ void vtkHapticLoop::Tick(double timeStep)
   internal.CutDurations[slot] = 0.0f;
   internal.MonitorDurations[slot] = 0.0f;
   internal.ShieldBuilds[slot] = 0;
+  internal.Work[slot] = Internals::ModelWork{};
   vtkHapticDevice* device = internal.Device;
   device->Synchronize(tick);
   if (internal.Switch)
@@ -1054,8 +1111,13 @@ void vtkHapticLoop::Tick(double timeStep)
 
   vtkHapticForceModel::Result result;
   const Clock::time_point modelStart = Clock::now();
+  if (!internal.CutInTicks && this->FeelPendingCuts)
+  {
+    internal.Pending.ShowTo(internal.Model);
+  }
   internal.Model->Update(position, rotation, timeStep, drilling, result);
   internal.ModelDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - modelStart).count();
+  internal.Work[slot] = { result.NumberOfContacts, result.NumberOfProxySteps, result.NumberOfSamples, static_cast<float>(result.Immersion) };
 
   bool cut = false;
   if (drilling && result.Cut)
@@ -1369,9 +1431,9 @@ int vtkHapticLoop::GetNumberOfKeptTicks() const
 }
 
 //------------------------------------------------------------------------------
-bool vtkHapticLoop::GetTickProfile(int index, double profile[8]) const
+bool vtkHapticLoop::GetTickProfile(int index, double profile[12]) const
 {
-  static_assert(NumberOfTickProfileFields == 8, "the profile's array holds every field");
+  static_assert(NumberOfTickProfileFields == 12, "the profile's array holds every field");
   const Internals& internal = *this->Internal;
   if (index < 0 || index >= this->GetNumberOfKeptTicks())
   {
@@ -1389,6 +1451,11 @@ bool vtkHapticLoop::GetTickProfile(int index, double profile[8]) const
   profile[ProfileShieldBricksBuilt] = internal.ShieldBuilds[slot];
   profile[ProfilePageFaults] = internal.PageFaults[slot];
   profile[ProfilePreemptions] = internal.Preemptions[slot];
+  const Internals::ModelWork& work = internal.Work[slot];
+  profile[ProfileContacts] = work.Contacts;
+  profile[ProfileProxySteps] = work.ProxySteps;
+  profile[ProfileSamples] = work.Samples;
+  profile[ProfileImmersion] = work.Immersion;
   return true;
 }
 
@@ -1427,5 +1494,7 @@ void vtkHapticLoop::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "PrepareShieldAhead: " << (this->PrepareShieldAhead ? "on" : "off") << "\n";
   os << indent << "ShieldLookAhead: " << this->ShieldLookAhead << " mm\n";
   os << indent << "AsynchronousCutting: " << (this->AsynchronousCutting ? "on" : "off") << "\n";
+  os << indent << "FeelPendingCuts: " << (this->FeelPendingCuts ? "on" : "off") << "\n";
+  os << indent << "ReplayCutterDelay: " << this->ReplayCutterDelay << " ticks\n";
   os << indent << "DeviceScale: " << this->GetDeviceScale() << "\n";
 }

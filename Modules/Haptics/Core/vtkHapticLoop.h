@@ -17,9 +17,10 @@
  * in order, as soon as they come. A segment of a fine field (a 4 mm burr on
  * 0.15 mm voxels) costs hundreds of microseconds, the first of a stroke a
  * millisecond and more: in the tick that would be half the period or an
- * overrun, while the force only needs the field as the cutter left it a
- * moment ago (GetMaximumCutLatency: from the tick to the cut made). The same
- * segments are cut as without it, the shield with them.
+ * overrun (GetMaximumCutLatency: from the tick to the cut made). The same
+ * segments are cut as without it, the shield with them. The force model
+ * counts the segments queued and not cut yet as removed (FeelPendingCuts),
+ * so that the hand feels what cutting in the tick would have left.
  *
  * Real-time path: no allocation, no lock, nothing shared with the renderer
  * or MRML but lock-free exchanges (with the cutter too). The tick reads devices through their
@@ -56,8 +57,8 @@
  * periods are kept for the last StatisticsCapacity ticks.
  *
  * RunTicks performs the same ticks on the calling thread without waiting
- * between them, cutting in the tick, for deterministic replays
- * (vtkReplayHapticDevice) and tests.
+ * between them, cutting in the tick (or with a cutter ReplayCutterDelay
+ * ticks behind), for deterministic replays (vtkReplayHapticDevice) and tests.
  *
  * @sa vtkHapticDevice vtkHapticForceModel vtkHapticRecorder
  */
@@ -195,11 +196,38 @@ public:
   /**
    * Set/get whether the cutter thread cuts the stroke's segments that the
    * ticks queue (see Cutting above) instead of the ticks themselves. Default
-   * is on. Set while stopped; RunTicks always cuts in the tick.
+   * is on. Set while stopped; RunTicks cuts in the tick unless ReplayCutterDelay is set.
    */
   vtkSetMacro(AsynchronousCutting, bool);
   vtkGetMacro(AsynchronousCutting, bool);
   vtkBooleanMacro(AsynchronousCutting, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get whether, with AsynchronousCutting, each tick's force model counts
+   * the segments queued and not cut yet as removed
+   * (vtkHapticForceModel::AddPendingCut; the spherical burr's capsules), so
+   * that the hand feels the bone as cutting in the tick would have left it
+   * however far the cutter is behind. Off, the proxy meets the bone the
+   * cutter has not reached yet. Default is on. Set while stopped.
+   */
+  vtkSetMacro(FeelPendingCuts, bool);
+  vtkGetMacro(FeelPendingCuts, bool);
+  vtkBooleanMacro(FeelPendingCuts, bool);
+  ///@}
+
+  ///@{
+  /**
+   * Set/get the delay (ticks) of a deterministic cutter for RunTicks: with
+   * AsynchronousCutting and a delay of n > 0, RunTicks queues the ticks'
+   * cuts as the thread does and cuts each one on the calling thread before
+   * the tick n ticks after the one that queued it (Stop cuts the rest): the
+   * asynchronous path replayed exactly, a cutter that far behind. Default is
+   * 0 (RunTicks cuts in the tick). Set before the first RunTicks of a session.
+   */
+  vtkSetClampMacro(ReplayCutterDelay, int, 0, 1000);
+  vtkGetMacro(ReplayCutterDelay, int);
   ///@}
 
   ///@{
@@ -347,6 +375,12 @@ public:
     /// processor from it (involuntary context switches); 0 where the system does not count them per thread.
     ProfilePageFaults,
     ProfilePreemptions,
+    /// The force model's work: shell points in material at its last contact test, its contact tests, the points of
+    /// the anatomy all its tests looked up (traces included), and the deepest contact (mm) at the last test.
+    ProfileContacts,
+    ProfileProxySteps,
+    ProfileSamples,
+    ProfileImmersion,
     NumberOfTickProfileFields
   };
 
@@ -355,9 +389,10 @@ public:
    * TickProfileField; index 0 is the oldest kept. Read while stopped. False
    * for an index beyond GetNumberOfKeptTicks. Overruns are told from the
    * machine's own noise by these: a slow tick with a fast processor time
-   * and preemptions was the system's, one with page faults touched new memory.
+   * and preemptions was the system's, one with page faults touched new memory,
+   * one with many samples had the force model trace deep contacts.
    */
-  bool GetTickProfile(int index, double profile[8]) const;
+  bool GetTickProfile(int index, double profile[12]) const;
   int GetNumberOfKeptTicks() const;
 
 protected:
@@ -382,6 +417,8 @@ protected:
   bool PrepareShieldAhead = true;
   double ShieldLookAhead = 3.0;
   bool AsynchronousCutting = true;
+  bool FeelPendingCuts = true;
+  int ReplayCutterDelay = 0;
   int NumberOfCutStrokes = 0;
   int NumberOfDrillPresses = 0;
   int NumberOfDrillReleases = 0;

@@ -219,6 +219,7 @@ int vtkHapticLoopTest1(int argc, char* argv[])
   CHECK_INT(loop->GetNumberOfKeptTicks(), recorded);
   double profile[vtkHapticLoop::NumberOfTickProfileFields];
   int cuttingTicks = 0;
+  int contactTicks = 0;
   int overfull = 0;
   for (int n = 0; n < loop->GetNumberOfKeptTicks(); ++n)
   {
@@ -227,8 +228,17 @@ int vtkHapticLoopTest1(int argc, char* argv[])
     overfull += parts > profile[vtkHapticLoop::ProfileDuration] + 0.01 ? 1 : 0;
     cuttingTicks += profile[vtkHapticLoop::ProfileCut] > 0.0 ? 1 : 0;
     CHECK_BOOL(profile[vtkHapticLoop::ProfilePageFaults] >= 0.0 && profile[vtkHapticLoop::ProfilePreemptions] >= 0.0, true);
+    // The force model's work: each contact test looks up every shell point (82) and traces the contacts;
+    // a deepest contact deeper than the burr (2.5 mm) would be a trace past its centre.
+    const double steps = profile[vtkHapticLoop::ProfileProxySteps];
+    CHECK_BOOL(steps <= model->GetProxyIterations(), true);
+    CHECK_BOOL(profile[vtkHapticLoop::ProfileSamples] >= 82.0 * steps, true);
+    CHECK_BOOL(profile[vtkHapticLoop::ProfileContacts] <= 82.0, true);
+    CHECK_BOOL(profile[vtkHapticLoop::ProfileImmersion] >= 0.0 && profile[vtkHapticLoop::ProfileImmersion] <= 2.5, true);
+    contactTicks += profile[vtkHapticLoop::ProfileContacts] > 0.0 && profile[vtkHapticLoop::ProfileImmersion] > 0.0 ? 1 : 0;
   }
   CHECK_INT(overfull, 0);
+  CHECK_BOOL(contactTicks >= cuttingTicks, true);
   std::cout << cuttingTicks << " of " << recorded << " ticks cut" << std::endl;
   CHECK_BOOL(cuttingTicks > 100, true);
   CHECK_BOOL(loop->GetTickProfile(recorded, profile), false);

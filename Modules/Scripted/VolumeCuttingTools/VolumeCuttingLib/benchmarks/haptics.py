@@ -29,8 +29,9 @@ Real data with protected structures: the temporal-bone case
 slice, loaded through ``owndata`` as a user's files, 11 structures
 protected), the same recorded session drilled along the floor of the ear
 canal, without rendering, with the loop's cutter thread cutting the segments
-the ticks queue (the default) against the same replay cutting in the ticks
-(both with the shield preparer), in alternating pairs; the cut and the
+the ticks queue while the force model counts those it has not cut yet as
+removed (the default) against the same replay cutting in the ticks (both
+with the shield preparer), in alternating rounds; the cut and the
 shield are forgotten before each replay, so every replay starts from none.
 Before each pair the same loop runs with ticks that do nothing (a virtual
 device in the air of a 4-voxel CT, ``hapticsjob.idle_loop``): its longest
@@ -160,12 +161,47 @@ def _replay(application, cut_node, plan, out_dir, frame):
 TEMPORAL_BONE_PLAN = dict(entry=(20.0, 5.0, -2.5), direction=(-1.0, 0.0, 0.0), surface_radius=0.0)
 
 
-#: Alternating pairs of temporal-bone replays (cutter thread, cutting in the ticks).
-TEMPORAL_BONE_PAIRS = 3
+#: Alternating rounds of temporal-bone replays, one of each mode a round (see ``REPLAY_MODES``).
+TEMPORAL_BONE_ROUNDS = 3
+
+#: The loop's ways of cutting, replayed in turn: the cutter thread with the force model counting the
+#: segments it has not cut yet as removed (the default), the cutter thread without that (the force model
+#: meets the bone the cutter has not reached yet), and cutting in the ticks.
+REPLAY_MODES = {
+    "cutter": dict(asynchronous_cutting=True, feel_pending_cuts=True),
+    "cutter_unfelt": dict(asynchronous_cutting=True, feel_pending_cuts=False),
+    "in_ticks": dict(asynchronous_cutting=False),
+}
+
+
+def _replayed_forces(folder: Path) -> np.ndarray:
+    """The force the replay sent at each tick (N), from its recording."""
+    recorder = slicer.vtkHapticRecorder()
+    if not recorder.ReadFile(str(folder / "haptic_replay.vchr")):
+        raise RuntimeError(f"the replay's recording in {folder} could not be read back (see the log)")
+    forces = np.zeros((recorder.GetNumberOfTicks(), 3))
+    force = [0.0, 0.0, 0.0]
+    for n in range(len(forces)):
+        recorder.GetTickForce(n, force)
+        forces[n] = force
+    return forces
+
+
+#: A tick whose force differs from the replay cutting in the ticks by more than this (N) felt another bone.
+FELT_DIFFERENCE_N = 0.05
+
+
+def _force_difference(forces: np.ndarray, reference: np.ndarray) -> tuple[int, float]:
+    """Ticks whose force differs from the reference replay's at the same tick by more than
+    ``FELT_DIFFERENCE_N``, and the median difference over the ticks (N). Replays cutting in the ticks
+    give the same forces bit for bit, so every difference is the cutter's."""
+    count = min(len(forces), len(reference))
+    differences = np.linalg.norm(forces[:count] - reference[:count], axis=1)
+    return int(np.sum(differences > FELT_DIFFERENCE_N)), float(np.median(differences)) if count else 0.0
 
 
 def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
-    """Replays on the temporal-bone case, with the loop's cutter and cutting in the ticks, in alternating pairs."""
+    """Replays on the temporal-bone case in each of ``REPLAY_MODES``, in alternating rounds."""
 
     application = HeadlessSlicer()
     files = temporalbone.cached_case_files()
@@ -178,34 +214,47 @@ def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
     plan = SimpleNamespace(**{key: np.asarray(value) if isinstance(value, tuple) else value
                               for key, value in TEMPORAL_BONE_PLAN.items()})
     protection = logic.GetCutField(cut_node).GetProtection()
-    runs = {True: [], False: []}
+    runs = {mode: [] for mode in REPLAY_MODES}
+    # Per round, each mode's forces against the same round's replay cutting in the ticks.
+    force_differences = {mode: [] for mode in REPLAY_MODES}
     idle = []
-    for pair in range(TEMPORAL_BONE_PAIRS):
+    modes = list(REPLAY_MODES)
+    for round_index in range(TEMPORAL_BONE_ROUNDS):
         idle.append(hapticsjob.idle_loop())
-        for cutter in (True, False):
+        forces = {}
+        # Each round starts with another mode: none always follows the idle loop or the same neighbour.
+        for mode in modes[round_index % len(modes):] + modes[:round_index % len(modes)]:
             logic.ClearCut(cut_node)
             protection.ClearBricks()
-            folder = out_dir / f"temporalbone-{pair}-{'cutter' if cutter else 'in-ticks'}"
+            folder = out_dir / f"temporalbone-{round_index}-{mode}"
             folder.mkdir()
-            runs[cutter].append(hapticsjob.run(application, cut_node, plan, folder, asynchronous_cutting=cutter))
+            runs[mode].append(hapticsjob.run(application, cut_node, plan, folder, **REPLAY_MODES[mode]))
+            forces[mode] = _replayed_forces(folder)
+        for mode in REPLAY_MODES:
+            force_differences[mode].append(_force_difference(forces[mode], forces["in_ticks"]))
 
     def worst(replays, key):
         return max(replay[key] for replay in replays)
 
-    after, before = runs[True], runs[False]
+    def median(replays, key):
+        return float(np.median([replay[key] for replay in replays]))
+
+    def work(replays, statistic, field):
+        """The force model's work over the replays' ticks (the profile's p99 or max of a field), median of the replays."""
+        return float(np.median([replay["tick_profile"][statistic][field] for replay in replays]))
+
+    after, unfelt, before = runs["cutter"], runs["cutter_unfelt"], runs["in_ticks"]
     ticks = sum(replay["ticks_run"] for replay in after)
     where = (f"temporal-bone case ({'x'.join(str(n) for n in temporalbone.DIMENSIONS)} voxels of "
              f"{temporalbone.SPACING} mm, {after[0]['protected_segments']} protected structures, via owndata), "
-             f"replayed drilling along the ear canal ({TEMPORAL_BONE_PAIRS} replays of {after[0]['ticks_run']} ticks, "
-             f"no rendering), cutter thread")
+             f"replayed drilling along the ear canal ({TEMPORAL_BONE_ROUNDS} replays of {after[0]['ticks_run']} ticks, "
+             f"no rendering), cutter thread, pending cuts felt")
     baseline = (f"the same replays cutting in the ticks, alternating with them in the same run "
                 f"(shield preparer on in both)")
     results = []
     for label, key in (("p50", "tick_us_p50"), ("p99", "tick_us_p99")):
-        median = float(np.median([replay[key] for replay in after]))
-        results.append(measurement(f"one haptic tick on the {where}: {label} (median of the replays)", median, "us",
-                                   f"{baseline}: {label}", float(np.median([replay[key] for replay in before])),
-                                   ticks, machine))
+        results.append(measurement(f"one haptic tick on the {where}: {label} (median of the replays)", median(after, key),
+                                   "us", f"{baseline}: {label}", median(before, key), ticks, machine))
     results.append(measurement(f"one haptic tick on the {where}: max (over the replays)", worst(after, "tick_us_max"),
                                "us", f"{baseline}: max", worst(before, "tick_us_max"), ticks, machine))
     results.append(measurement(f"the same tick, processor time of the haptic thread: max (over the replays)",
@@ -214,6 +263,36 @@ def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
     results.append(measurement(f"haptic loop overruns on the {where} (all replays)",
                                sum(replay["overruns"] for replay in after), "ticks", baseline,
                                sum(replay["overruns"] for replay in before), 1, machine))
+    unfelt_name = "the same replays with the cutter thread, pending cuts not felt (the force model meets uncut bone)"
+    for label, key in (("p99", "tick_us_p99"), ("max", "tick_us_max")):
+        results.append(measurement(f"one haptic tick on the {where}: {label} (median of the replays)", median(after, key),
+                                   "us", f"{unfelt_name}: {label}", median(unfelt, key), ticks, machine))
+    results.append(measurement(f"haptic loop overruns on the {where} (all replays)",
+                               sum(replay["overruns"] for replay in after), "ticks", unfelt_name,
+                               sum(replay["overruns"] for replay in unfelt), 1, machine))
+    # What the force model does in a tick: the anatomy's points its contact tests look up (traces
+    # included) and its time, the same in every mode if the cutter being behind does not change its work.
+    for statistic in ("p99", "max"):
+        results.append(measurement(
+            f"points of the anatomy the force model looked up in a tick on the {where}: {statistic} (median of the replays)",
+            work(after, f"{statistic}_us", "samples"), "lookups", f"{baseline}: {statistic}",
+            work(before, f"{statistic}_us", "samples"), ticks, machine))
+    results.append(measurement(
+        f"the force model's part of a tick on the {where}: p99 (median of the replays)",
+        work(after, "p99_us", "force_model_us"), "us", f"{baseline}: p99", work(before, "p99_us", "force_model_us"),
+        ticks, machine))
+    results.append(measurement(
+        f"ticks whose force differs by more than {FELT_DIFFERENCE_N} N from the same round's replay cutting in the ticks, "
+        f"on the {where} (all rounds)", sum(count for count, _ in force_differences["cutter"]), "ticks",
+        f"{unfelt_name}, the same count", sum(count for count, _ in force_differences["cutter_unfelt"]), ticks, machine))
+    results.append(measurement(
+        f"difference of the force sent at the same tick from the same round's replay cutting in the ticks, on the "
+        f"{where} (median over the ticks, median of the rounds)",
+        float(np.median([median for _, median in force_differences["cutter"]])), "N", f"{unfelt_name}, the same difference",
+        float(np.median([median for _, median in force_differences["cutter_unfelt"]])), ticks, machine))
+    results.append(measurement(
+        f"mean force while drilling on the {where} (median of the replays)", median(after, "force_mean_while_drilling_n"),
+        "N", f"{baseline} (the same feel: ratio about 1)", median(before, "force_mean_while_drilling_n"), ticks, machine))
     results.append(measurement(f"shield bricks the haptic thread built in its ticks on the {where} (all replays)",
                                sum(replay["shield_bricks_built_in_ticks"] for replay in after), "bricks", baseline,
                                sum(replay["shield_bricks_built_in_ticks"] for replay in before), 1, machine))
@@ -221,9 +300,8 @@ def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
                                worst(after, "cut_us_max"), "us", f"{baseline}: the cut stroke's part, max",
                                worst(before, "cut_us_max"), ticks, machine))
     results.append(measurement(f"one segment cut by the cutter thread on the {where}: p99 (median of the replays)",
-                               float(np.median([replay["cutter_us_p99"] for replay in after])), "us",
-                               f"{baseline}: the cut stroke's part of a tick, p99",
-                               float(np.median([replay["cut_us_p99"] for replay in before])), ticks, machine))
+                               median(after, "cutter_us_p99"), "us", f"{baseline}: the cut stroke's part of a tick, p99",
+                               median(before, "cut_us_p99"), ticks, machine))
     results.append(measurement(f"longest time from a tick to its segment cut by the cutter on the {where}",
                                worst(after, "cut_latency_us_max"), "us", "one period of the 1 kHz loop", 1000.0, 1,
                                machine))
@@ -231,17 +309,16 @@ def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
                                after[0]["removed_volume_mm3"], "mm^3", f"{baseline} (the same strokes: ratio about 1)",
                                before[0]["removed_volume_mm3"], 1, machine))
     results.append(measurement(
-        "the machine's own noise: longest tick of the same 1 kHz loop with ticks that do nothing, before each pair "
-        f"({TEMPORAL_BONE_PAIRS} runs of 4.5 s, max)", max(run["tick_us_max"] for run in idle), "us",
+        "the machine's own noise: longest tick of the same 1 kHz loop with ticks that do nothing, before each round "
+        f"({TEMPORAL_BONE_ROUNDS} runs of 4.5 s, max)", max(run["tick_us_max"] for run in idle), "us",
         "the cutter thread's replays: max tick (above)", worst(after, "tick_us_max"),
         sum(run["ticks_run"] for run in idle), machine))
     results.append(measurement(
         "the machine's own noise: overruns of the do-nothing loop (all runs)", sum(run["overruns"] for run in idle),
         "ticks", "the cutter thread's replays: overruns (above)", sum(replay["overruns"] for replay in after), 1,
         machine))
-    profiles = {"cutter": [replay["tick_profile"] for replay in after],
-                "in_ticks": [replay["tick_profile"] for replay in before],
-                "idle": [run["profile"] for run in idle]}
+    profiles = {mode: [replay["tick_profile"] for replay in replays] for mode, replays in runs.items()}
+    profiles["idle"] = [run["profile"] for run in idle]
     for row in results:
         row["real_time_priority"] = after[0]["real_time_priority"]
     results[2]["slowest_ticks"] = {name: [tick for profile in group for tick in profile["slowest"][:2]]

@@ -103,7 +103,7 @@ def active_burr(scene, cut_node):
 SLOW_TICK_US = 500.0
 #: The parts of a tick's profile, in ``vtkHapticLoop.GetTickProfile``'s order.
 PROFILE_FIELDS = ("tick_us", "cpu_us", "force_model_us", "cut_us", "nerve_monitor_us", "shield_bricks_built",
-                  "page_faults", "preemptions")
+                  "page_faults", "preemptions", "contacts", "proxy_steps", "samples", "immersion_um")
 
 
 def tick_profile(loop, slowest: int = 5) -> dict:
@@ -118,6 +118,8 @@ def tick_profile(loop, slowest: int = 5) -> dict:
     for n in range(len(profiles)):
         loop.GetTickProfile(n, row)
         profiles[n] = row
+    # The deepest contact in micrometres, as the times are kept to a tenth of their unit.
+    profiles[:, PROFILE_FIELDS.index("immersion_um")] *= 1000.0
     if not len(profiles):
         return {"ticks": 0}
     order = np.argsort(profiles[:, 0])[::-1][:slowest]
@@ -195,7 +197,7 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
 
 
 def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None,
-        asynchronous_cutting: bool = True) -> dict:
+        asynchronous_cutting: bool = True, feel_pending_cuts: bool = True) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
@@ -205,7 +207,10 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     to be built by the haptic thread where it first reaches it (the
     comparison for the loop's preparer, ``vtkHapticLoop.SetPrepareShieldAhead``);
     ``asynchronous_cutting`` False cuts in the ticks instead of on the loop's
-    cutter thread (``vtkHapticLoop.SetAsynchronousCutting``).
+    cutter thread (``vtkHapticLoop.SetAsynchronousCutting``); ``feel_pending_cuts`` False
+    leaves out the segments queued and not cut yet from the force model
+    (``vtkHapticLoop.SetFeelPendingCuts``: the proxy then meets the bone the
+    cutter has not reached).
     The replayed ticks are also saved as a complete recording
     (``haptic_session.json``, ``recording.from_haptic_ticks``) on ``scan``
     (the scan descriptor a recording names), for grading.
@@ -240,6 +245,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     loop.SetRate(RATE_HZ)
     loop.SetPrepareShieldAhead(bool(prepare_shield_ahead))
     loop.SetAsynchronousCutting(bool(asynchronous_cutting))
+    loop.SetFeelPendingCuts(bool(feel_pending_cuts))
     replayed = slicer.vtkHapticRecorder()
     replayed.SetCapacity(ticks + 1000)
     loop.SetRecorder(replayed)
@@ -354,6 +360,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "cut_us_p99": round(loop.GetCutDurationPercentile(99.0), 1),
         "cut_us_max": round(loop.GetCutDurationPercentile(100.0), 1),
         "asynchronous_cutting": bool(loop.GetAsynchronousCutting()),
+        "feel_pending_cuts": bool(loop.GetFeelPendingCuts()),
         "cutter_us_p99": round(loop.GetCutterDurationPercentile(99.0), 1),
         "cutter_us_max": round(loop.GetCutterDurationPercentile(100.0), 1),
         "cut_latency_us_max": round(loop.GetMaximumCutLatency(), 1),
