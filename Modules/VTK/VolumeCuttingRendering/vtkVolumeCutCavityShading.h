@@ -16,8 +16,13 @@
  * the original material), up to Range mm, by
  * 1 - Strength (1 - (1 - d / Range)^2): nothing at the rim, where the cut
  * meets the uncut surface, darker with depth down the walls to the floor,
- * and constant (with a continuous slope) from Range on. Uncut surfaces and
- * the anatomy's own cavities are left as they are. The length is found by
+ * and constant (with a continuous slope) from Range on. This holds for
+ * every surface a cut exposes, not only the cut's own: where the carve
+ * stops on a segment's surface (SoftCut's floor on bone) the ray meets the
+ * cut's surface or the segment's a pixel at a time, and both must shade
+ * alike. In front of the first surface a ray meets, material is there only
+ * where a cut removed it: uncut surfaces and the anatomy's own cavities,
+ * with air before them, are left as they are. The length is found by
  * steps of Range / Steps along the line of sight, then bisection, so it
  * changes continuously over a wall (no bands at the steps) and the CPU and
  * the GPU (vtkVolumeCutAmbientOcclusionFS.glsl) agree.
@@ -33,7 +38,7 @@ class vtkVolumeCutCavityShading
 {
 public:
   /// Darkening at Range and beyond.
-  static constexpr double Strength = 0.55;
+  static constexpr double Strength = 0.45;
   /// Range as a share of the ambient occlusion radius (3 mm at the default 6 mm).
   static constexpr double RangeShare = 0.5;
   static constexpr int Steps = 12;
@@ -46,18 +51,14 @@ public:
   }
 
   /**
-   * Length (mm, at most the range) of original material between a cut
+   * Length (mm, at most the range) of original material between a
    * surface's point (IJK) and the eye, along \a view (world, unit, towards the eye).
    */
   double Depth(const double index[3], const double view[3]) const
   {
     const double range = RangeShare * this->Scene.AmbientOcclusionRadius;
     double step[3];
-    vtkVolumeCutRayMath::TransformVector(this->Scene.WorldToIJK, view, step);
-    for (int axis = 0; axis < 3; ++axis)
-    {
-      step[axis] *= range / Steps;
-    }
+    this->Step(view, step);
     // Last step in the material and first out of it, in steps from the point.
     double inside = 0.0;
     double outside = -1.0;
@@ -77,9 +78,21 @@ public:
     return 0.5 * (inside + outside) * range / Steps;
   }
 
-  /// Darken a cut surface's shaded colour by its depth under the original surface.
+  /**
+   * Darken a surface's shaded colour by its depth under the original
+   * surface. Where the point a quarter step before it is not in original
+   * material, the depth is under a quarter step (a shade of at most 2 %
+   * at the default radius), taken as none: the colour of every surface with
+   * air before it is left exactly as it is, at the cost of one sample.
+   */
   void Apply(const double index[3], const double view[3], float rgb[3]) const
   {
+    double step[3];
+    this->Step(view, step);
+    if (!this->InOriginalMaterial(index, step, 0.25))
+    {
+      return;
+    }
     const double share = 1.0 - this->Depth(index, view) / (RangeShare * this->Scene.AmbientOcclusionRadius);
     const float factor = static_cast<float>(1.0 - Strength * (1.0 - share * share));
     for (int c = 0; c < 3; ++c)
@@ -89,6 +102,16 @@ public:
   }
 
 private:
+  /// One step (IJK) along \a view (world, unit).
+  void Step(const double view[3], double step[3]) const
+  {
+    vtkVolumeCutRayMath::TransformVector(this->Scene.WorldToIJK, view, step);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      step[axis] *= RangeShare * this->Scene.AmbientOcclusionRadius / Steps;
+    }
+  }
+
   /// Whether index + steps * step (IJK) lies in visible material, cuts ignored (outside the volume: no).
   bool InOriginalMaterial(const double index[3], const double step[3], double steps) const
   {

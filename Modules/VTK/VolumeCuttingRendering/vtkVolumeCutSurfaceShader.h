@@ -11,8 +11,8 @@
  * segment whose material lies under the surface (MaterialOwner), the cut field's
  * gradient on cut surfaces, the plane's or box face's normal on clip
  * surfaces; Phong lighting with a headlight, ambient occlusion
- * (vtkVolumeCutAmbientOcclusion) with, on cut surfaces, cavity shading
- * (vtkVolumeCutCavityShading), and thin-bone shading
+ * (vtkVolumeCutAmbientOcclusion) with, on surfaces that cuts expose, cavity
+ * shading (vtkVolumeCutCavityShading), and thin-bone shading
  * (vtkVolumeCutThinBoneShader) where they are on.
  *
  * @sa vtkVolumeCutPieceClassifier (step 3)
@@ -165,10 +165,7 @@ public:
     if (this->Scene.AmbientOcclusion)
     {
       this->Occlusion.Apply(index, normal, ray.ViewAxis, rgb);
-      if (source >= vtkVolumeCutRayCaster::SourceCutField)
-      {
-        this->Cavity.Apply(index, ray.View, rgb);
-      }
+      this->Cavity.Apply(index, ray.View, rgb);
     }
     if (this->Scene.ThinBone)
     {
