@@ -19,6 +19,9 @@ import slicer_volumecutting as vc
 import vtk
 from vtkmodules.util import numpy_support
 
+from test_cavity_shading import render_as_the_application, scaled_ijk_to_ras, volume_image
+from VolumeCuttingLib.data.analyticscene import depth_to_points, world_to_ndc
+
 SPACING = 0.5
 DIMENSIONS = 48
 TOP = 18.0  # mm: the tissue's top face
@@ -34,18 +37,7 @@ def tissue():
     index = np.arange(DIMENSIONS) * SPACING
     z = np.meshgrid(index, index, index, indexing="ij")[0]
     inside = np.clip(0.5 + (TOP - z) / (2.0 * SPACING), 0.0, 1.0)
-    values = -1000.0 + 1040.0 * inside + np.random.default_rng(28).normal(0.0, 15.0, z.shape)
-    image = vtk.vtkImageData()
-    image.SetDimensions(DIMENSIONS, DIMENSIONS, DIMENSIONS)
-    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True))
-    return image
-
-
-def ijk_to_ras():
-    matrix = vtk.vtkMatrix4x4()
-    for axis in range(3):
-        matrix.SetElement(axis, axis, SPACING)
-    return matrix
+    return volume_image(-1000.0 + 1040.0 * inside + np.random.default_rng(28).normal(0.0, 15.0, z.shape))
 
 
 def carved_box():
@@ -55,61 +47,34 @@ def carved_box():
     z, y, x = np.meshgrid(index, index, index, indexing="ij")
     depth = 2.0 * (FLOOR - z)
     walls = np.maximum(np.abs(x - CENTRE[0]), np.abs(y - CENTRE[1])) - HALF_WIDTH
-    distances = vtk.vtkImageData()
-    distances.SetExtent(0, DIMENSIONS - 1, 0, DIMENSIONS - 1, 0, DIMENSIONS - 1)
-    array = numpy_support.numpy_to_vtk(np.maximum(depth, walls).astype(np.float32).ravel(), deep=True)
-    distances.GetPointData().SetScalars(array)
+    distances = volume_image(np.maximum(depth, walls))
     cut = vc.vtkVolumeCutField()
-    assert cut.Initialize([DIMENSIONS] * 3, ijk_to_ras(), 2)
+    assert cut.Initialize([DIMENSIONS] * 3, scaled_ijk_to_ras(SPACING), 2)
     assert cut.CutSampledRegion(distances)
     return cut
 
 
 def render_floor(path):
-    """Brightness (0..255) of the carved box seen from above at 30 degrees, and the floor's pixels."""
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(WIDTH, WIDTH)
-    renderer = vtk.vtkRenderer()
-    window.AddRenderer(renderer)
-    camera = renderer.GetActiveCamera()
-    direction = np.array([0.0, -np.sin(np.radians(30.0)), np.cos(np.radians(30.0))])
-    camera.SetFocalPoint(*CENTRE)
-    camera.SetPosition(*(CENTRE + 80.0 * direction))
-    camera.SetViewUp(0.0, 1.0, 0.0)
-    camera.OrthogonalizeViewUp()
-    camera.SetViewAngle(20.0)
-    camera.SetClippingRange(40.0, 140.0)
-    mapper = vc.vtkVolumeCutVolumeMapper()
-    mapper.SetInputData(tissue())
-    mapper.SetRequestedRenderPath(path)
-    caster = mapper.GetRayCaster()
-    caster.SetIsoValue(-500.0)
-    caster.SetAmbientOcclusion(True)  # as vtkMRMLVolumeCutNode's default
-    caster.AddCutField(carved_box())
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetUserMatrix(ijk_to_ras())
-    renderer.AddVolume(volume)
-    window.Render()
-    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, WIDTH - 1, WIDTH - 1, 1, rgba)
-    brightness = numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[..., :3].astype(float).mean(axis=2)
+    """Brightness (0..255, rows from the bottom) of the carved box seen from above at 30 degrees, and the floor's
+    pixels."""
+    def from_above(camera):
+        direction = np.array([0.0, -np.sin(np.radians(30.0)), np.cos(np.radians(30.0))])
+        camera.SetFocalPoint(*CENTRE)
+        camera.SetPosition(*(CENTRE + 80.0 * direction))
+        camera.SetViewUp(0.0, 1.0, 0.0)
+        camera.OrthogonalizeViewUp()
+        camera.SetViewAngle(20.0)
+        camera.SetClippingRange(40.0, 140.0)
+
+    brightness, window, camera = render_as_the_application(tissue(), SPACING, -500.0, carved_box(), path, from_above,
+                                                           WIDTH)
     depth = vtk.vtkFloatArray()
     window.GetZbufferData(0, 0, WIDTH - 1, WIDTH - 1, depth)
     depth = numpy_support.vtk_to_numpy(depth).reshape(WIDTH, WIDTH).astype(float)
     # The floor's pixels: the world points under the depth image on the floor, away from the walls.
-    matrix = vtk.vtkMatrix4x4()
-    matrix.DeepCopy(camera.GetCompositeProjectionTransformMatrix(1.0, -1.0, 1.0))
-    matrix.Invert()
-    ndc_to_world = np.array([[matrix.GetElement(r, c) for c in range(4)] for r in range(4)])
-    rows, columns = np.mgrid[0:WIDTH, 0:WIDTH]
-    ndc = np.stack([2.0 * (columns + 0.5) / WIDTH - 1.0, 2.0 * (rows + 0.5) / WIDTH - 1.0, 2.0 * depth - 1.0,
-                    np.ones_like(depth)], axis=-1)
-    world = ndc @ ndc_to_world.T
-    world = world[..., :3] / world[..., 3:]
-    floor = (np.abs(world[..., 2] - FLOOR) < 0.3) & (np.max(np.abs(world[..., :2] - CENTRE[:2]), axis=-1) < HALF_WIDTH - 1.0)
+    points = depth_to_points(world_to_ndc(camera, WIDTH, WIDTH), depth)
+    inner = np.max(np.abs(points[..., :2] - CENTRE[:2]), axis=-1) < HALF_WIDTH - 1.0
+    floor = (np.abs(points[..., 2] - FLOOR) < 0.3) & inner
     return brightness, floor
 
 
@@ -121,9 +86,11 @@ def isolated_dark(brightness, mask):
     return mask & (brightness < np.median(neighbours, axis=0) - DARKER)
 
 
-@pytest.mark.parametrize("path", [vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath], ids=["cpu", "gpu"])
+@pytest.mark.parametrize("path", [vc.vtkVolumeCutVolumeMapper.CPUPath, vc.vtkVolumeCutVolumeMapper.GPUPath],
+                         ids=["cpu", "gpu"])
 def test_a_carved_floor_has_no_isolated_dark_pixels(path):
     brightness, floor = render_floor(path)
     assert np.count_nonzero(floor) > 0.1 * WIDTH * WIDTH, "the floor should fill much of the view"
     specks = isolated_dark(brightness, floor)
-    assert np.count_nonzero(specks) == 0, f"{np.count_nonzero(specks)} isolated dark pixels among {np.count_nonzero(floor)} of the floor"
+    count = np.count_nonzero(specks)
+    assert count == 0, f"{count} isolated dark pixels among {np.count_nonzero(floor)} of the floor"

@@ -13,7 +13,6 @@ path (here llvmpipe) must draw the same image.
 """
 
 import numpy as np
-import pytest
 import slicer_volumecutting as vc
 import vtk
 from vtkmodules.util import numpy_support
@@ -29,6 +28,51 @@ CPU = vc.vtkVolumeCutVolumeMapper.CPUPath
 GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
 
 
+def volume_image(values):
+    """A float image of values (z, y, x) with unit spacing, as the mapper's input."""
+    image = vtk.vtkImageData()
+    image.SetDimensions(*values.shape[::-1])
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True))
+    return image
+
+
+def scaled_ijk_to_ras(spacing):
+    matrix = vtk.vtkMatrix4x4()
+    for axis in range(3):
+        matrix.SetElement(axis, axis, spacing)
+    return matrix
+
+
+def render_as_the_application(ct, spacing, iso, cut, path, place_camera, width=WIDTH):
+    """Brightness (0..255, rows from the bottom) of one path's still frame of ct at iso with ambient occlusion on,
+    as vtkMRMLVolumeCutNode's default, and a cut field (or None); place_camera(camera) sets the view. Also the
+    window and the camera, for the depth image."""
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(width, width)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    place_camera(renderer.GetActiveCamera())
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(ct)
+    mapper.SetRequestedRenderPath(path)
+    caster = mapper.GetRayCaster()
+    caster.SetIsoValue(iso)
+    caster.SetAmbientOcclusion(True)
+    if cut is not None:
+        caster.AddCutField(cut)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetUserMatrix(scaled_ijk_to_ras(spacing))
+    renderer.AddVolume(volume)
+    window.Render()
+    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
+    brightness = numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4)[..., :3].astype(float).mean(axis=2)
+    return brightness, window, renderer.GetActiveCamera()
+
+
 def block(bump_centre_depth=None):
     """Bone 1000 under z = TOP (a two-voxel partial-volume ramp, fixed-seed noise), with a ball of the burr's
     radius added whose centre lies this deep under the top (a bump), as a scan."""
@@ -39,56 +83,27 @@ def block(bump_centre_depth=None):
         radius = np.sqrt((x - CENTRE[0]) ** 2 + (y - CENTRE[1]) ** 2 + (z - CENTRE[2] + bump_centre_depth) ** 2)
         inside = np.maximum(inside, BURR_RADIUS - radius)
     values = 1000.0 * np.clip(0.5 + inside / (2.0 * SPACING), 0.0, 1.0)
-    values += np.random.default_rng(28).normal(0.0, 15.0, values.shape)
-    image = vtk.vtkImageData()
-    image.SetDimensions(DIMENSIONS, DIMENSIONS, DIMENSIONS)
-    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True))
-    return image
-
-
-def ijk_to_ras():
-    matrix = vtk.vtkMatrix4x4()
-    for axis in range(3):
-        matrix.SetElement(axis, axis, SPACING)
-    return matrix
+    return volume_image(values + np.random.default_rng(28).normal(0.0, 15.0, values.shape))
 
 
 def render_head_on(path, pit_centre_height=None, bump_centre_depth=None):
     """Brightness (0..255, rows from the top) of the block seen along -z, with a burr's pit whose centre lies
     this high over the top (0: a hemisphere) or a bump."""
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(WIDTH, WIDTH)
-    renderer = vtk.vtkRenderer()
-    window.AddRenderer(renderer)
-    camera = renderer.GetActiveCamera()
-    camera.ParallelProjectionOn()
-    camera.SetParallelScale(FIELD_MM / 2.0)
-    camera.SetFocalPoint(*CENTRE)
-    camera.SetPosition(*(CENTRE + [0.0, 0.0, 60.0]))
-    camera.SetViewUp(0.0, 1.0, 0.0)
-    camera.SetClippingRange(20.0, 120.0)
-    mapper = vc.vtkVolumeCutVolumeMapper()
-    mapper.SetInputData(block(bump_centre_depth))
-    mapper.SetRequestedRenderPath(path)
-    caster = mapper.GetRayCaster()
-    caster.SetIsoValue(500.0)
-    caster.SetAmbientOcclusion(True)  # as vtkMRMLVolumeCutNode's default
+    def head_on(camera):
+        camera.ParallelProjectionOn()
+        camera.SetParallelScale(FIELD_MM / 2.0)
+        camera.SetFocalPoint(*CENTRE)
+        camera.SetPosition(*(CENTRE + [0.0, 0.0, 60.0]))
+        camera.SetViewUp(0.0, 1.0, 0.0)
+        camera.SetClippingRange(20.0, 120.0)
+
+    cut = None
     if pit_centre_height is not None:
         cut = vc.vtkVolumeCutField()
-        assert cut.Initialize([DIMENSIONS] * 3, ijk_to_ras(), 2)
+        assert cut.Initialize([DIMENSIONS] * 3, scaled_ijk_to_ras(SPACING), 2)
         centre = list(CENTRE + [0.0, 0.0, pit_centre_height])
         assert cut.CutCapsule(centre, centre, BURR_RADIUS)
-        caster.AddCutField(cut)
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetUserMatrix(ijk_to_ras())
-    renderer.AddVolume(volume)
-    window.Render()
-    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, WIDTH - 1, WIDTH - 1, 1, rgba)
-    return numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[::-1, :, :3].astype(float).mean(axis=2)
+    return render_as_the_application(block(bump_centre_depth), SPACING, 500.0, cut, path, head_on)[0][::-1]
 
 
 def from_axis_mm():
