@@ -196,7 +196,11 @@ public:
    * it, up to AmbientOcclusionRadius (mm) away over its normal's
    * hemisphere, lies in visible material (cuts removed), each point weighed
    * by its depth in the material so that the term varies smoothly over a
-   * surface (vtkVolumeCutAmbientOcclusion). Off by default; radius 6 mm.
+   * surface (vtkVolumeCutAmbientOcclusion). With it, cut surfaces are
+   * darkened by the length of original material between them and the eye,
+   * up to half the radius (vtkVolumeCutCavityShading), so that a drilled
+   * pit seen head-on reads as a cavity, not as a bump. Off by default;
+   * radius 6 mm.
    */
   vtkSetMacro(AmbientOcclusion, bool);
   vtkGetMacro(AmbientOcclusion, bool);

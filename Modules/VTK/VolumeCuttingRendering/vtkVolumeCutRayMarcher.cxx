@@ -166,11 +166,22 @@ void vtkVolumeCutRayMarcher::Cast(const vtkVolumeCutRayScene& scene, const doubl
       }
     }
     const double landing = a.T + std::floor((std::min(clearUntil, tEnd) - a.T) / step) * step;
+    vtkVolumeCutSample landed = vtkVolumeCutSample::At(o, d, landing);
+    bool landedVisible = false;
     if (landing > a.T + step)
     {
-      a = vtkVolumeCutSample::At(o, d, landing);
-      classifier.EvaluateObject(a);
-      insideVisible = classifier.Visible(a);
+      classifier.EvaluateObject(landed);
+      landedVisible = classifier.Visible(landed);
+    }
+    // A cut field's value is not always the distance along the ray (SoftCut's
+    // region is a depth along the plan's normal): a jump across the removed
+    // depth that lands in visible material overshot the cut's surface, and
+    // would shade the pixel with the CT's normal inside the tissue, a dark
+    // or bright speck on a carved floor (issue 28). The ray marches on instead.
+    if (landing > a.T + step && !(landedVisible && a.Object != 0))
+    {
+      a = landed;
+      insideVisible = landedVisible;
       if (insideVisible && shader.Enter(ray, a, a.T, vtkVolumeCutRayCaster::SourceObject, result))
       {
         return;

@@ -58,7 +58,8 @@ std::string vtkVolumeCutShaderComposer::FragmentShader(const Features& features)
   // loops never reach the compiler.
   vtkShaderProgram::Substitute(source, "//VolumeCut::AmbientOcclusion::Dec",
     features.AmbientOcclusion ? vtkVolumeCutAmbientOcclusionFS
-                              : "const int ambientOcclusion = 0;\nfloat occlusion(vec3 index, vec3 normal) { return 0.0; }\n");
+                              : "const int ambientOcclusion = 0;\nfloat occlusion(vec3 index, vec3 normal) { return 0.0; }\n"
+                                "float cavityShade(vec3 index, vec3 view) { return 1.0; }\n");
   vtkShaderProgram::Substitute(source, "//VolumeCut::ThinBone::Dec",
     features.ThinBone ? vtkVolumeCutThinBoneFS
                       : "const int thinBone = 0;\n"

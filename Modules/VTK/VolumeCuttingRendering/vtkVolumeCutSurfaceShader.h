@@ -11,7 +11,8 @@
  * segment whose material lies under the surface (MaterialOwner), the cut field's
  * gradient on cut surfaces, the plane's or box face's normal on clip
  * surfaces; Phong lighting with a headlight, ambient occlusion
- * (vtkVolumeCutAmbientOcclusion) and thin-bone shading
+ * (vtkVolumeCutAmbientOcclusion) with, on surfaces that cuts expose, cavity
+ * shading (vtkVolumeCutCavityShading), and thin-bone shading
  * (vtkVolumeCutThinBoneShader) where they are on.
  *
  * @sa vtkVolumeCutPieceClassifier (step 3)
@@ -20,6 +21,7 @@
 #define vtkVolumeCutSurfaceShader_h
 
 #include "vtkVolumeCutAmbientOcclusion.h"
+#include "vtkVolumeCutCavityShading.h"
 #include "vtkVolumeCutRayResult.h"
 #include "vtkVolumeCutThinBoneShader.h"
 
@@ -35,6 +37,7 @@ public:
     , Classifier(classifier)
     , ThinBone(scene, classifier)
     , Occlusion(scene, classifier)
+    , Cavity(scene, classifier)
   {
   }
 
@@ -162,6 +165,7 @@ public:
     if (this->Scene.AmbientOcclusion)
     {
       this->Occlusion.Apply(index, normal, ray.ViewAxis, rgb);
+      this->Cavity.Apply(index, ray.View, rgb);
     }
     if (this->Scene.ThinBone)
     {
@@ -176,6 +180,7 @@ private:
   const vtkVolumeCutSampleClassifier& Classifier;
   vtkVolumeCutThinBoneShader ThinBone;
   vtkVolumeCutAmbientOcclusion Occlusion;
+  vtkVolumeCutCavityShading Cavity;
 };
 
 #endif

@@ -158,11 +158,19 @@ void main()
       float landing = a.t + floor((min(clearUntil, tEnd) - a.t) / stepLength) * stepLength;
       if (landing > a.t + stepLength)
       {
-        a = sampleAt(landing);
-        evaluateObject(a);
-        insideVisible = visible(a);
-        done = insideVisible && enter(a, a.t, SOURCE_OBJECT);
-        continue;
+        Sample landed = sampleAt(landing);
+        evaluateObject(landed);
+        bool landedVisible = visible(landed);
+        // A jump across a removed depth that lands in visible material
+        // overshot the cut's surface (vtkVolumeCutRayMarcher.cxx says why):
+        // the ray marches on instead.
+        if (!(landedVisible && a.object != 0))
+        {
+          a = landed;
+          insideVisible = landedVisible;
+          done = insideVisible && enter(a, a.t, SOURCE_OBJECT);
+          continue;
+        }
       }
     }
     Sample b = sampleAt(min(a.t + stepLength, tEnd));

@@ -94,6 +94,7 @@ bool enter(Sample piece, float t, int source)
   if (ambientOcclusion != 0)
   {
     rgb *= 1.0 - 0.9 * occlusion(index, normal);
+    rgb *= cavityShade(index, viewVector);
   }
   if (thinBone != 0)
   {

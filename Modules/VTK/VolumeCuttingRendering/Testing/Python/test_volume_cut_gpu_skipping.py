@@ -84,8 +84,9 @@ float jumpTooFar(vec3 p, float t)
 CAVITY_JUMP_TOO_FAR = """
 float cavityTooFar(Sample s)
 {
-  // Half a millimetre past the removed depth.
-  return removedDepthExit(s) + 0.5;
+  // Past everything behind the floor: a jump that lands in visible material
+  // is refused (the ray marches on), one that leaves the object is not.
+  return removedDepthExit(s) + 1.0e4;
 }
 #define removedDepthExit(s) cavityTooFar(s)
 """
@@ -278,7 +279,9 @@ def test_a_surface_just_past_a_long_empty_run(program_cache):
 
 def test_a_cavity_floor_just_beyond_the_removed_depth(program_cache):
     # The analytic cube with pits drilled into its top face: deep in a pit the
-    # ray jumps its removed depth and must still land before the floor.
+    # ray jumps its removed depth and must still land before the floor (a
+    # landing in visible material is refused, so the breakage jumps past
+    # the cube).
     scene = A.CubeScene(dimensions=40, half_size_voxels=12)
     c, h, s = scene.center, scene.half_size, scene.spacing
     scene.spheres = [A.Sphere(tuple(c + [1.3 * s, -2.1 * s, h + 0.7 * s]), 6.2 * s), A.Sphere(tuple(c + [-6.4 * s, 5.9 * s, h - 0.4 * s]), 4.3 * s)]
