@@ -67,7 +67,11 @@ bool vtkVirtualHapticDevice::SetPose(const double position[3], unsigned int butt
 //------------------------------------------------------------------------------
 bool vtkVirtualHapticDevice::SetPoseAndOrientation(const double position[3], const double orientation[4], unsigned int buttons)
 {
-  if (!this->IsConnected())
+  // Connected alone is not enough: a reconnection attempt says Connected
+  // while it opens (so that a loss reported at once is kept), and a pose
+  // taken in that instant from an unplugged device would show the loop a
+  // device that came back and went again.
+  if (!this->IsConnected() || !this->GetPlugged())
   {
     return false;
   }

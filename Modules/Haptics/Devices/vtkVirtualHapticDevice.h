@@ -36,7 +36,7 @@ public:
   /**
    * The handle's position (mm, device frame) and buttons; the orientation
    * stays as it was (identity at first). Ignored, returning false, while
-   * the device is not connected; a non-finite position is rejected and
+   * the device is not connected or unplugged; a non-finite position is rejected and
    * counted (see GetNumberOfRejectedInputs).
    */
   bool SetPose(const double position[3], unsigned int buttons);

@@ -200,5 +200,35 @@ int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_INT(loop->GetNumberOfDeviceLosses(), 1);
   CHECK_BOOL(device->IsConnected(), true);
   CHECK_BOOL(scene.Field->IsStrokeOpen(), false);
+
+  // While a device is unplugged, every reconnection attempt fails; none may
+  // let a pose through, or the loop sees the device come back and go again
+  // (two losses for one unplug, as CI once saw). A hand thread pushes poses
+  // as fast as it can while the main thread retries a few thousand times.
+  vtkNew<vtkVirtualHapticDevice> unplugged;
+  unplugged->SetReconnectInterval(0.0);
+  CHECK_BOOL(unplugged->Open(), true);
+  unplugged->SetPlugged(false);
+  std::atomic<bool> retrying{ true };
+  std::atomic<int> posesTaken{ 0 };
+  std::thread pusher([&]() {
+    const double where[3] = { 1.0, 2.0, 3.0 };
+    while (retrying.load())
+    {
+      posesTaken += unplugged->SetPose(where, 0u) ? 1 : 0;
+    }
+  });
+  TESTING_OUTPUT_ASSERT_WARNINGS_BEGIN();
+  for (int attempt = 0; attempt < 20000; ++attempt)
+  {
+    unplugged->ProcessConnectionEvents();
+  }
+  TESTING_OUTPUT_ASSERT_WARNINGS_END();
+  retrying = false;
+  pusher.join();
+  std::cout << posesTaken.load() << " poses taken by an unplugged device during 20000 reconnection attempts" << std::endl;
+  CHECK_INT(posesTaken.load(), 0);
+  double nowhere[3];
+  CHECK_BOOL(unplugged->GetLatestPosition(nowhere), false);
   return EXIT_SUCCESS;
 }
