@@ -27,7 +27,9 @@
 
 // STD includes
 #include <chrono>
+#include <condition_variable>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -40,19 +42,70 @@ struct vtkSlicerVolumeCuttingNerveMonitors::State
   std::vector<std::string> SegmentIds; // monitored now, by structure index
   std::vector<std::string> Names;
   std::string Source;                  // what the monitor was built from
-  std::thread Builder;
   std::chrono::steady_clock::time_point Start = std::chrono::steady_clock::now();
   std::vector<double> LastRowTimes;
   int LevelChanges = 0;
 
-  void Join()
+  // One builder per monitor, asked again whenever the structures change. A
+  // role change must not wait for the fields of the previous choice (seconds
+  // on a large scan): the monitor drops a field whose structures changed
+  // while it was built, and the builder then builds the new ones.
+  std::thread Builder;
+  std::mutex BuilderMutex;
+  std::condition_variable BuilderChanged;
+  bool BuildRequested = false;
+  bool Building = false;
+  bool Stopping = false;
+
+  void RequestBuild()
   {
+    std::lock_guard<std::mutex> lock(this->BuilderMutex);
+    this->BuildRequested = true;
+    if (!this->Builder.joinable())
+    {
+      this->Builder = std::thread([this] { this->BuildWhenAsked(); });
+    }
+    this->BuilderChanged.notify_all();
+  }
+
+  void BuildWhenAsked()
+  {
+    std::unique_lock<std::mutex> lock(this->BuilderMutex);
+    for (;;)
+    {
+      this->BuilderChanged.wait(lock, [this] { return this->BuildRequested || this->Stopping; });
+      if (this->Stopping)
+      {
+        return;
+      }
+      this->BuildRequested = false;
+      this->Building = true;
+      lock.unlock();
+      this->Monitor->Build();
+      lock.lock();
+      this->Building = false;
+      this->BuilderChanged.notify_all();
+    }
+  }
+
+  void WaitUntilIdle()
+  {
+    std::unique_lock<std::mutex> lock(this->BuilderMutex);
+    this->BuilderChanged.wait(lock, [this] { return !this->BuildRequested && !this->Building; });
+  }
+
+  ~State()
+  {
+    {
+      std::lock_guard<std::mutex> lock(this->BuilderMutex);
+      this->Stopping = true;
+      this->BuilderChanged.notify_all();
+    }
     if (this->Builder.joinable())
     {
       this->Builder.join();
     }
   }
-  ~State() { this->Join(); }
 };
 
 //----------------------------------------------------------------------------
@@ -120,7 +173,6 @@ vtkVolumeCutNerveMonitor* vtkSlicerVolumeCuttingNerveMonitors::GetMonitor(vtkMRM
     return state->SegmentIds.empty() ? nullptr : state->Monitor.GetPointer();
   }
   // The segments changed: new structures from their labels on the anatomy's grid.
-  state->Join();
   state->Source = source.str();
   state->SegmentIds.clear();
   state->Names.clear();
@@ -154,8 +206,7 @@ vtkVolumeCutNerveMonitor* vtkSlicerVolumeCuttingNerveMonitors::GetMonitor(vtkMRM
     return nullptr;
   }
   // The fields are built off the threads that measure: readings are "not ready" until then.
-  vtkVolumeCutNerveMonitor* building = monitor;
-  state->Builder = std::thread([building] { building->Build(); });
+  state->RequestBuild();
   return monitor;
 }
 
@@ -167,7 +218,7 @@ bool vtkSlicerVolumeCuttingNerveMonitors::Wait(vtkMRMLVolumeCutNode* cutNode)
   {
     return false;
   }
-  state->Join();
+  state->WaitUntilIdle();
   return state->Monitor->IsBuilt();
 }
 
