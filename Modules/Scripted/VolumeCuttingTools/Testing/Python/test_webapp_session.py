@@ -418,3 +418,35 @@ def test_softcut_example_outline_needs_the_head_ct(session):
     assert not softcut.has_example_outline()
     with pytest.raises(SessionError, match="example head CT"):
         softcut.use_example_outline()
+
+
+def test_an_own_segmentation_opens_with_roles_given_by_name(tmp_path):
+    """``vc app --ct --segmentation --cuttable --protected``: roles by name, as the main job takes them."""
+    parser = argparse.ArgumentParser()
+    webapp.add_arguments(parser)
+    options = webapp.options_from_arguments(parser.parse_args(
+        ["--ct", "ct.nrrd", "--segmentation", "labels.nrrd", "--cuttable", "Mastoid bone,Air cells", "--protected", "Facial nerve"]))
+    assert (options.cuttable, options.protected) == ("Mastoid bone,Air cells", "Facial nerve")
+    with pytest.raises(SystemExit, match="name segments of --segmentation"):
+        webapp.options_from_arguments(parser.parse_args(["--ct", "ct.nrrd", "--protected", "Facial nerve"]))
+    from test_assessment_owndata import own_case
+    from trame_slicer.core import SlicerApp
+
+    slicer_app = SlicerApp()
+    logic = slicer_app.register_module_logic(slicer.vtkSlicerVolumeCuttingLogic(), logic_name="VolumeCutting")
+    ct_path, labels_path = own_case(tmp_path)
+    own = DrillSession(slicer_app.scene, logic, tmp_path / "own")
+    own.load("own", ct_path=ct_path, segmentation_path=labels_path)
+    assert {row.role for row in own.segment_rows()} == {""}  # without names every segment starts without a role
+    cut_node = own.cut_node
+    with pytest.raises(owndata.InputError, match="no segment named 'Cochlea'.*Facial nerve"):
+        own.load("own", ct_path=ct_path, segmentation_path=labels_path, cuttable_names="temporal bone",
+                 protected_names="Cochlea")
+    assert own.cut_node is cut_node  # the data before the refused load stays
+    own.load("own", ct_path=ct_path, segmentation_path=labels_path, cuttable_names="temporal bone",
+             protected_names="facial_nerve")
+    roles = {row.name: row.role for row in own.segment_rows()}
+    assert roles["Temporal bone"] == "cuttable" and roles["Facial nerve"] == "protected", roles
+    with pytest.raises(SessionError, match="Roles by name need the segmentation"):
+        own.load("own", ct_path=ct_path, cuttable_names="temporal bone")
+    own.close()

@@ -94,6 +94,8 @@ class Options:
     source: str = "headct"
     ct: Path | None = None
     segmentation: Path | None = None
+    cuttable: str = ""  # segment names, comma-separated, with --segmentation
+    protected: str = ""
     data_dirs: list[Path] = field(default_factory=list)
     max_upload_mb: float = 512.0
     navigate_scale: float = 0.5
@@ -117,6 +119,11 @@ def add_arguments(parser) -> None:
     data.add_argument("--ct", type=Path, default=None,
                       help="start with this CT: a DICOM series folder, .nrrd, .nii, .nii.gz, .mha (default: the example head CT)")
     group.add_argument("--segmentation", type=Path, default=None, help="its segmentation (.seg.nrrd or labelmap), with --ct")
+    group.add_argument("--cuttable", default="", metavar="NAMES",
+                       help="with --segmentation: comma-separated names of the segments the drill may cut "
+                            "(default: none; the Segments panel sets roles too)")
+    group.add_argument("--protected", default="", metavar="NAMES",
+                       help="with --segmentation: comma-separated names of the segments the drill must not cut")
     group.add_argument("--data-dir", type=Path, action="append", default=[],
                        help="a folder whose files users may load by path (repeatable; default: the download cache)")
     group.add_argument("--max-upload-mb", type=float, default=Options.max_upload_mb, help="largest upload accepted (MB)")
@@ -139,6 +146,8 @@ def add_arguments(parser) -> None:
 def options_from_arguments(args) -> Options:
     if args.segmentation is not None and args.ct is None:
         raise SystemExit("--segmentation goes with --ct")
+    if (args.cuttable or args.protected) and args.segmentation is None:
+        raise SystemExit("--cuttable and --protected name segments of --segmentation: give it (with --ct)")
     for name in ("navigate_scale", "drill_scale"):
         value = getattr(args, name)
         if not 0.05 <= value <= 1.0:
@@ -153,7 +162,8 @@ def options_from_arguments(args) -> Options:
         openigtlink = igtloptions.options_from_arguments(args)
     except ValueError as error:
         raise SystemExit(str(error)) from None
-    return Options(source=source, ct=args.ct, segmentation=args.segmentation, data_dirs=data_dirs,
+    return Options(source=source, ct=args.ct, segmentation=args.segmentation, cuttable=args.cuttable,
+                   protected=args.protected, data_dirs=data_dirs,
                    max_upload_mb=args.max_upload_mb, navigate_scale=args.navigate_scale, drill_scale=args.drill_scale,
                    navigate_fps=args.navigate_fps, work_dir=args.work_dir, records=args.records, openigtlink=openigtlink,
                    test_hooks=args.test_hooks)
@@ -1248,7 +1258,8 @@ def main(argv=None) -> int:
     args, _ = server.cli.parse_known_args(argv)
     options = options_from_arguments(args)
     app = VolumeCuttingApp(server, options)
-    paths = {"ct_path": options.ct, "segmentation_path": options.segmentation} if options.source == "own" else {}
+    paths = {"ct_path": options.ct, "segmentation_path": options.segmentation, "cuttable_names": options.cuttable,
+             "protected_names": options.protected} if options.source == "own" else {}
 
     def load_at_start(**_):
         # The data loads while the page opens: the page shows the progress.

@@ -180,7 +180,8 @@ class DrillSession:
         for _ in self.loading(source, **options):
             pass
 
-    def loading(self, source: str, ct_path=None, segmentation_path=None, color_table=None, seed: int = 0):
+    def loading(self, source: str, ct_path=None, segmentation_path=None, color_table=None, seed: int = 0,
+                cuttable_names="", protected_names=""):
         """Load new data step by step, yielding (fraction done, what comes next) between steps.
 
         ``source``: "headct" (the example head CT, its bone segmented
@@ -189,7 +190,9 @@ class DrillSession:
         or "own" (the user's CT at ``ct_path``: a DICOM series, NRRD, NIfTI
         or MetaImage; with ``segmentation_path`` every segment starts
         without a role, without it the bone is segmented automatically and
-        made cuttable). The new data is built beside the old and replaces it
+        made cuttable; ``cuttable_names`` and ``protected_names`` give roles
+        to segments of the user's segmentation by name, as the main job's
+        options do). The new data is built beside the old and replaces it
         only when all of it is ready: input that cannot be used raises
         ``owndata.InputError`` or ``SessionError`` and leaves the previous
         data as it was.
@@ -205,6 +208,8 @@ class DrillSession:
                 raise SessionError("Give the CT: upload it or name its path on the server")
             if segmentation_path is not None:
                 roles = ((), ())
+            elif cuttable_names or protected_names:
+                raise SessionError("Roles by name need the segmentation they name: give it with the CT")
         created = []
         try:
             yield 0.05, "Reading the CT"
@@ -247,6 +252,8 @@ class DrillSession:
             if roles is None:
                 cuttable = [self.logic.GetCorticalBoneSegmentID(), self.logic.GetTrabecularBoneSegmentID()]
                 protected = []
+            elif source == "own":
+                cuttable, protected = owndata.resolve_roles(roles_segmentation, cuttable_names, protected_names)
             else:
                 present = set(roles_segmentation.GetSegmentation().GetSegmentIDs())
                 cuttable = [s for s in roles[0] if s in present]
