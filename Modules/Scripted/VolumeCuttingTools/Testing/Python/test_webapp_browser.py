@@ -36,7 +36,7 @@ import numpy as np
 import pytest
 from playwright.sync_api import TimeoutError as PlaywrightTimeoutError
 
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer
+from VolumeCuttingLib.webapp.browser import AppPage, AppServer, opened_app_page, screenshot_folder
 
 pytestmark = pytest.mark.browser
 
@@ -48,10 +48,7 @@ VIEWPORT = {"width": 1440, "height": 900}
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory):
-    folder = os.environ.get("VOLUMECUTTING_SCREENSHOTS")
-    path = Path(folder) if folder else tmp_path_factory.mktemp("webapp-screenshots")
-    path.mkdir(parents=True, exist_ok=True)
-    return path
+    return screenshot_folder(tmp_path_factory, "webapp-screenshots")
 
 
 @pytest.fixture(scope="module")
@@ -68,15 +65,8 @@ def server(tmp_path_factory, data_dir):
 
 @pytest.fixture(scope="module")
 def app(server, browser):
-    context = browser.new_context(viewport=VIEWPORT, device_scale_factor=1, accept_downloads=True)
-    page = context.new_page()
-    page.set_default_timeout(60000)
-    application = AppPage(page, timing=True)
-    application.open(server.url)
-    application.wait_ready(300)
-    application.wait_still(1500, 300)
-    yield application
-    context.close()
+    with opened_app_page(browser, server.url, timing=True, still_ms=1500, downloads=True) as application:
+        yield application
 
 
 def view_point(app, fx, fy):

@@ -31,13 +31,12 @@ Screenshots of an interactive frame and the release frame go to
 import os
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from VolumeCuttingLib.benchmarks.webapp import MOUSE_PERIOD_MS, VIEW_SIZE, drag_path, event_latencies
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer
+from VolumeCuttingLib.webapp.browser import AppPage, AppServer, screenshot_folder
 
 pytestmark = [pytest.mark.browser, pytest.mark.realdata]
 
@@ -57,10 +56,7 @@ BLACK = 12
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory):
-    folder = os.environ.get("VOLUMECUTTING_SCREENSHOTS")
-    path = Path(folder) if folder else tmp_path_factory.mktemp("camera-drag-screenshots")
-    path.mkdir(parents=True, exist_ok=True)
-    return path
+    return screenshot_folder(tmp_path_factory, "camera-drag-screenshots")
 
 
 def black_share(pixels: np.ndarray) -> float:

@@ -10,16 +10,13 @@ colour in the server's scene (the colour the 3D view draws it in) and gets its
 own back when the burr leaves.
 """
 
-import os
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from VolumeCuttingLib.data import phantom
 from VolumeCuttingLib.feedback import nervemonitor
 from VolumeCuttingLib.webapp import monitormeter
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer
+from VolumeCuttingLib.webapp.browser import AppServer, opened_app_page, screenshot_folder
 from VolumeCuttingLib.webapp.session import PHANTOM_DIMENSIONS, PHANTOM_SPACING
 
 pytestmark = pytest.mark.browser
@@ -33,24 +30,14 @@ TOLERANCE_MM = 0.6
 
 @pytest.fixture(scope="module")
 def shots(tmp_path_factory):
-    folder = os.environ.get("VOLUMECUTTING_SCREENSHOTS")
-    path = Path(folder) if folder else tmp_path_factory.mktemp("webapp-monitor-screenshots")
-    path.mkdir(parents=True, exist_ok=True)
-    return path
+    return screenshot_folder(tmp_path_factory, "webapp-monitor-screenshots")
 
 
 @pytest.fixture(scope="module")
 def app(browser, tmp_path_factory):
     log = tmp_path_factory.mktemp("webapp-monitor") / "server.log"
-    with AppServer("--phantom", log_path=log) as server:
-        context = browser.new_context(viewport={"width": 1440, "height": 900}, device_scale_factor=1)
-        page = context.new_page()
-        page.set_default_timeout(60000)
-        application = AppPage(page)
-        application.open(server.url)
-        application.wait_ready(300)
+    with AppServer("--phantom", log_path=log) as server, opened_app_page(browser, server.url) as application:
         yield application
-        context.close()
 
 
 def nerve_arc():

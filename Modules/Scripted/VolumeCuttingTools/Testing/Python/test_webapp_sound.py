@@ -13,7 +13,7 @@ import pytest
 
 from VolumeCuttingLib.feedback import drillsound, soundanalysis
 from VolumeCuttingLib.feedback.drillsound import SoundParameters
-from VolumeCuttingLib.webapp.browser import AppPage, AppServer, SoundPage
+from VolumeCuttingLib.webapp.browser import AppServer, SoundPage, opened_app_page
 
 pytestmark = pytest.mark.browser
 
@@ -113,16 +113,8 @@ def test_a_change_is_heard_within_50_ms_in_the_browser(sound_page):
 @pytest.fixture(scope="module")
 def app(browser, tmp_path_factory):
     log = tmp_path_factory.mktemp("webapp-sound") / "server.log"
-    with AppServer("--phantom", log_path=log) as server:
-        context = browser.new_context(viewport={"width": 1440, "height": 900}, device_scale_factor=1)
-        page = context.new_page()
-        page.set_default_timeout(60000)
-        application = AppPage(page)
-        application.open(server.url)
-        application.wait_ready(300)
-        application.wait_still(1500, 300)
+    with AppServer("--phantom", log_path=log) as server, opened_app_page(browser, server.url, still_ms=1500) as application:
         yield application
-        context.close()
 
 
 def test_the_page_has_a_sound_switch_and_volume(app):

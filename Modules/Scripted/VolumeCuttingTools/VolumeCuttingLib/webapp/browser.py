@@ -11,7 +11,9 @@ Shared by the browser tests and the ``webapp`` benchmark area:
   exports; and, for timing, the time each frame of the 3D view reached the
   page (``TIMING_HOOK``);
 * ``SoundPage``: the page's drill sound (AudioWorklet) alone, rendered
-  offline or timed live.
+  offline or timed live;
+* ``opened_app_page`` and ``screenshot_folder``: the set-up every browser
+  test shares (a desktop-sized page, ready; where its pictures go).
 
 Every wait has a time limit and says what it waited for when it runs out.
 """
@@ -25,12 +27,13 @@ import socket
 import subprocess
 import sys
 import time
-from contextlib import closing
+from contextlib import closing, contextmanager
 from pathlib import Path
 
 import numpy as np
 
 CHROMIUM_CANDIDATES = ("/usr/bin/chromium", "/usr/bin/chromium-browser")
+DESKTOP_VIEWPORT = {"width": 1440, "height": 900}
 
 # Records, in the page, when each frame of each view arrived and was ready to
 # show (decoded, at the next animation frame), with the server's encoding
@@ -439,3 +442,32 @@ class SoundPage:
             return self.page.evaluate("([a, b, n]) => window.vcDrillSound.measureLatency(a, b, n)", [before, after, trials])
         finally:
             self.page.evaluate("() => window.vcDrillSound.stop()")
+
+
+def screenshot_folder(tmp_path_factory, name: str) -> Path:
+    """Where a browser test's screenshots go: ``$VOLUMECUTTING_SCREENSHOTS`` (Docs/webapp's pictures) or a new
+    temporary folder ``name`` from pytest's ``tmp_path_factory``."""
+    folder = os.environ.get("VOLUMECUTTING_SCREENSHOTS")
+    path = Path(folder) if folder else tmp_path_factory.mktemp(name)
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+@contextmanager
+def opened_app_page(browser, url: str, timing: bool = False, still_ms: float | None = None, downloads: bool = False,
+                    viewport: dict | None = None, timeout_s: float = 300.0):
+    """A page of the application at ``url`` in a browser context of its own, once its data is shown (and, with
+    ``still_ms``, the 3D view stayed still that long); the context is closed on leaving."""
+    context = browser.new_context(viewport=viewport or DESKTOP_VIEWPORT, device_scale_factor=1,
+                                  accept_downloads=downloads)
+    try:
+        page = context.new_page()
+        page.set_default_timeout(60000)
+        app = AppPage(page, timing=timing)
+        app.open(url, timeout_s)  # a large scan is read before the page is served
+        app.wait_ready(timeout_s)
+        if still_ms is not None:
+            app.wait_still(still_ms, timeout_s)
+        yield app
+    finally:
+        context.close()
