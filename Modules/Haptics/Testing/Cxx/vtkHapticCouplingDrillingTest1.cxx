@@ -13,7 +13,7 @@
 // The instructor's hand (a 0.3 N/mm arm) moves to a spot 1.8 mm inside the
 // bone, at its own device's coordinates of that spot; the trainee's hand is
 // relaxed, the drill on. Criteria, for one-way delays of 0, 5 and 20 ms with
-// 10 % loss (and 0 ms without loss), ticked in lockstep at 1 kHz on loopback:
+// 10 % loss, ticked in lockstep at 1 kHz on loopback:
 //  - the trainee's tool reaches the spot in RAS: within 0.5 mm after 3 s
 //    (1 mm with 20 ms of delay, where the tanks run dry);
 //  - it drilled there: removed volume > 0, and not one protected voxel removed;
@@ -43,6 +43,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <utility>
 
 namespace
 {
@@ -151,54 +152,6 @@ void ToDevice(const Session& side, const double ras[3], double device[3])
   std::copy(mapped, mapped + 3, device);
 }
 
-/// A label image of the protected cylinder on the scene's grid, and how many voxels it holds.
-vtkIdType CylinderLabels(vtkHapticTestScene& scene, vtkImageData* labels)
-{
-  labels->SetDimensions(scene.Size, scene.Size, scene.Size);
-  labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
-  vtkIdType inside = 0;
-  for (int k = 0; k < scene.Size; ++k)
-  {
-    for (int j = 0; j < scene.Size; ++j)
-    {
-      for (int i = 0; i < scene.Size; ++i)
-      {
-        const double ijk[4] = { double(i), double(j), double(k), 1.0 };
-        double ras[4];
-        scene.IJKToRAS->MultiplyPoint(ijk, ras);
-        const double dx = ras[0] - CylinderX, dz = ras[2] - CylinderZ;
-        const bool in = dx * dx + dz * dz <= CylinderRadius * CylinderRadius;
-        *static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) = in ? 1 : 0;
-        inside += in ? 1 : 0;
-      }
-    }
-  }
-  return inside;
-}
-
-/// Protected voxels the field shows removed (their centre's signed distance not positive).
-int ProtectedRemoved(vtkHapticTestScene& scene, vtkImageData* labels, vtkVolumeCutField* field)
-{
-  int removed = 0;
-  for (int k = 0; k < scene.Size; ++k)
-  {
-    for (int j = 0; j < scene.Size; ++j)
-    {
-      for (int i = 0; i < scene.Size; ++i)
-      {
-        if (*static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) != 0)
-        {
-          const double ijk[4] = { double(i), double(j), double(k), 1.0 };
-          double ras[4];
-          scene.IJKToRAS->MultiplyPoint(ijk, ras);
-          removed += field->GetSignedDistance(ras) > 0.0 ? 0 : 1;
-        }
-      }
-    }
-  }
-  return removed;
-}
-
 struct Outcome
 {
   double MaximumForce = 0.0;
@@ -230,7 +183,11 @@ bool Guide(vtkHapticTestScene& scene, vtkImageData* instructorScan, double delay
   const int dims[3] = { scene.Size, scene.Size, scene.Size };
   field->Initialize(dims, scene.IJKToRAS, 2);
   vtkNew<vtkImageData> labels;
-  if (CylinderLabels(scene, labels) == 0 || !field->SetProtectedLabels(labels))
+  const vtkIdType cylinder = scene.MakeLabels(labels, [](const double ras[3]) {
+    const double dx = ras[0] - CylinderX, dz = ras[2] - CylinderZ;
+    return dx * dx + dz * dz <= CylinderRadius * CylinderRadius;
+  });
+  if (cylinder == 0 || !field->SetProtectedLabels(labels))
   {
     return false;
   }
@@ -306,7 +263,7 @@ bool Guide(vtkHapticTestScene& scene, vtkImageData* instructorScan, double delay
   trainee.Loop->Stop();
   instructor.Loop->Stop();
   outcome.Removed = field->ComputeRemovedVolume();
-  outcome.ProtectedRemoved = ProtectedRemoved(scene, labels, field);
+  outcome.ProtectedRemoved = scene.CountRemovedLabelled(labels, field);
   int index = 0;
   for (Session* side : { &trainee, &instructor })
   {
@@ -355,7 +312,7 @@ int vtkHapticCouplingDrillingTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[
   }
 
   // Guided drilling on the same scan: delay x loss.
-  const double links[4][2] = { { 0.0, 0.0 }, { 0.0, 0.1 }, { 0.005, 0.1 }, { 0.020, 0.1 } };
+  const double links[3][2] = { { 0.0, 0.1 }, { 0.005, 0.1 }, { 0.020, 0.1 } };
   for (const auto& link : links)
   {
     Outcome outcome;
