@@ -37,6 +37,11 @@ struct Published
 /// Time constant (s) of the proxy velocity's low-pass: device quantisation
 /// noise would otherwise reach the damper (about 50 Hz).
 constexpr double VelocityTimeConstant = 0.003;
+
+/// How far (device mm) a handle may move in one tick beyond the step its
+/// velocity predicts: a 0.1 kg handle under the device's 3.3 N moves 0.017 mm
+/// further in 1 ms; the passivity controller keeps the tank able to pay for it.
+constexpr double DisplacementMargin = 0.02;
 } // namespace
 
 struct vtkHapticCoupling::Internals
@@ -247,30 +252,38 @@ void vtkHapticCoupling::Update(double time, const double proxy[3], const double 
   };
   limit(force);
 
-  // Passivity controller: the tank pays for the next tick's predicted work,
-  // or the part of the force along the handle's velocity goes (a variable
-  // damper); with a deficit it dissipates. Shrinking the force afterwards
-  // only lowers the work it can do.
+  // Passivity controller. First the tank must pay for the next tick's
+  // predicted work: the part of the force along the handle's velocity that
+  // it cannot pay for goes (a variable damper that stops at zero power: a
+  // damper acting on a velocity one tick old, pushed past that, reverses a
+  // light handle within the tick and does work instead of taking it).
+  // Then the force is capped so that the tank also pays for the work of any
+  // displacement the prediction misses: up to DisplacementMargin beyond the
+  // predicted step, what the operator's hand and the tool's contacts (forces
+  // the coupling does not know) can add in one tick. Without the cap, a hand
+  // blocked by bone and pushed by its contacts goes where the prediction does
+  // not expect it, and the misses add up to a tank deep in deficit. An empty
+  // tank lets no force out. Shrinking a force only lowers the work it can do.
   if (this->PassivityControl && present)
   {
-    const double budget = internal.Tank / period;
+    const double tank = std::max(internal.Tank, 0.0);
+    const double budget = tank / period;
     const double power = vtkMath::Dot(force, internal.HandleVelocity);
-    if (power > budget)
+    const double speed2 = vtkMath::Dot(internal.HandleVelocity, internal.HandleVelocity);
+    if (power > budget && speed2 > 1e-9)
     {
-      const double speed2 = vtkMath::Dot(internal.HandleVelocity, internal.HandleVelocity);
-      if (speed2 > 1e-9)
+      const double damper = (power - budget) / speed2;
+      for (int axis = 0; axis < 3; ++axis)
       {
-        const double damper = (power - budget) / speed2;
-        for (int axis = 0; axis < 3; ++axis)
-        {
-          force[axis] -= damper * internal.HandleVelocity[axis];
-        }
-        limit(force);
+        force[axis] -= damper * internal.HandleVelocity[axis];
       }
-      else
-      {
-        std::fill(force, force + 3, 0.0);
-      }
+    }
+    const double reach = std::sqrt(speed2) * period + DisplacementMargin;
+    const double affordable = tank / reach;
+    const double norm = vtkMath::Norm(force);
+    if (norm > affordable)
+    {
+      vtkMath::MultiplyScalar(force, norm > 0.0 ? affordable / norm : 0.0);
     }
   }
 

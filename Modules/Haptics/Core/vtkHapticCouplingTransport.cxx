@@ -2,7 +2,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkHapticCouplingTransport.h"
 
+#include "vtkDataArray.h"
+#include "vtkImageData.h"
+#include "vtkMatrix4x4.h"
 #include "vtkObjectFactory.h"
+#include "vtkPointData.h"
 
 #include <array>
 #include <atomic>
@@ -177,6 +181,8 @@ struct vtkHapticCouplingTransport::Internals
   std::atomic<unsigned long long> Stale{ 0 };
   std::atomic<unsigned long long> ForeignSession{ 0 };
   std::atomic<unsigned long long> ForeignHost{ 0 };
+  std::atomic<unsigned long long> FrameMismatches{ 0 };
+  std::atomic<unsigned long long> LastRefusedFrame{ 0 };
 
   /// Uniform in [0, 1).
   double NextRandom()
@@ -251,6 +257,7 @@ void vtkHapticCouplingTransport::EncodePacket(const State& state, unsigned char 
   }
   PutDouble(packet + 76, state.EnergySent);
   PutDouble(packet + 84, state.Tank);
+  PutUnsigned(packet + 92, state.Frame, 8);
   PutUnsigned(packet + ChecksumOffset, CRC32(packet, ChecksumOffset), 4);
 }
 
@@ -276,6 +283,7 @@ bool vtkHapticCouplingTransport::DecodePacket(const unsigned char* packet, int s
   }
   decoded.EnergySent = GetDouble(packet + 76);
   decoded.Tank = GetDouble(packet + 84);
+  decoded.Frame = GetUnsigned(packet + 92, 8);
   // A valid checksum over nonsense (a buggy or hostile sender) is refused as well.
   if (!finite || !std::isfinite(decoded.Tank) || !std::isfinite(decoded.EnergySent) || decoded.EnergySent < 0.0 ||
     decoded.Session == 0 || decoded.Sequence == 0)
@@ -365,7 +373,7 @@ bool vtkHapticCouplingTransport::Open(const char* localHost, int localPort, cons
   internal.Queue.assign(4096, Delayed{});
   internal.QueueHead = internal.QueueCount = 0;
   for (auto* counter : { &internal.Sent, &internal.Lost, &internal.SendFailures, &internal.Accepted, &internal.Garbled,
-         &internal.Stale, &internal.ForeignSession, &internal.ForeignHost })
+         &internal.Stale, &internal.ForeignSession, &internal.ForeignHost, &internal.FrameMismatches, &internal.LastRefusedFrame })
   {
     counter->store(0);
   }
@@ -456,6 +464,7 @@ bool vtkHapticCouplingTransport::Send(State& state, double now)
   }
   state.Session = internal.Session;
   state.Sequence = internal.NextSequence++;
+  state.Frame = this->FrameFingerprint;
   internal.WriteDue(now);
   if (this->InjectedLossRate > 0.0 && internal.NextRandom() < this->InjectedLossRate)
   {
@@ -538,6 +547,21 @@ bool vtkHapticCouplingTransport::ReceiveLatest(double now, State& latest)
       internal.Garbled.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
+    if (state.Frame != this->FrameFingerprint)
+    {
+      // Positions in another frame (another scan, or a free device's millimetres) mean other places: never a peer.
+      internal.FrameMismatches.fetch_add(1, std::memory_order_relaxed);
+      internal.LastRefusedFrame.store(state.Frame, std::memory_order_relaxed);
+      if (!fromPeer && !internal.HavePeer)
+      {
+        // Listening, nobody joined yet: answer it, so that the joining side hears this frame and can say why it is
+        // refused rather than wait for an answer that never comes. It still never becomes the peer.
+        internal.Remote = from;
+        internal.PeerAddressKnown = true;
+        internal.PublishPeer();
+      }
+      continue;
+    }
     if (internal.HavePeer && state.Session != internal.PeerSession)
     {
       // Another session: the peer restarted, or someone else talks. Only a silent peer gives way.
@@ -612,6 +636,61 @@ unsigned long long vtkHapticCouplingTransport::GetNumberOfForeignHostPackets() c
   return this->Internal->ForeignHost.load(std::memory_order_relaxed);
 }
 
+unsigned long long vtkHapticCouplingTransport::GetNumberOfFrameMismatches() const
+{
+  return this->Internal->FrameMismatches.load(std::memory_order_relaxed);
+}
+
+unsigned long long vtkHapticCouplingTransport::GetLastRefusedFrame() const
+{
+  return this->Internal->LastRefusedFrame.load(std::memory_order_relaxed);
+}
+
+//------------------------------------------------------------------------------
+unsigned long long vtkHapticCouplingTransport::ComputeFrameFingerprint(vtkImageData* anatomy, vtkMatrix4x4* ijkToRAS)
+{
+  vtkDataArray* scalars = anatomy ? anatomy->GetPointData()->GetScalars() : nullptr;
+  if (!scalars || !ijkToRAS)
+  {
+    return 0;
+  }
+  // FNV-1a, 64 bits: the same bytes give the same value on every platform (all fields little-endian here).
+  std::uint64_t hash = 0xCBF29CE484222325ull;
+  const auto mix = [&hash](const unsigned char* bytes, size_t count) {
+    for (size_t n = 0; n < count; ++n)
+    {
+      hash = (hash ^ bytes[n]) * 0x100000001B3ull;
+    }
+  };
+  const auto mixUnsigned = [&mix](std::uint64_t value) {
+    unsigned char bytes[8];
+    PutUnsigned(bytes, value, 8);
+    mix(bytes, 8);
+  };
+  int dimensions[3];
+  anatomy->GetDimensions(dimensions);
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    mixUnsigned(static_cast<std::uint64_t>(dimensions[axis]));
+  }
+  for (int row = 0; row < 4; ++row)
+  {
+    for (int column = 0; column < 4; ++column)
+    {
+      // -0 and +0 are the same placement.
+      const double value = ijkToRAS->GetElement(row, column) + 0.0;
+      std::uint64_t bits;
+      std::memcpy(&bits, &value, sizeof(bits));
+      mixUnsigned(bits);
+    }
+  }
+  mixUnsigned(static_cast<std::uint64_t>(scalars->GetDataType()));
+  mixUnsigned(static_cast<std::uint64_t>(scalars->GetNumberOfComponents()));
+  const size_t size = static_cast<size_t>(scalars->GetNumberOfValues()) * static_cast<size_t>(scalars->GetDataTypeSize());
+  mix(static_cast<const unsigned char*>(scalars->GetVoidPointer(0)), size);
+  return hash != 0 ? hash : 1;
+}
+
 //------------------------------------------------------------------------------
 void vtkHapticCouplingTransport::PrintSelf(ostream& os, vtkIndent indent)
 {
@@ -620,6 +699,8 @@ void vtkHapticCouplingTransport::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "LocalPort: " << this->GetLocalPort() << "\n";
   os << indent << "Listening: " << (this->IsListening() ? "yes" : "no") << "\n";
   os << indent << "PeerAddress: " << this->GetPeerAddress() << "\n";
+  os << indent << "FrameFingerprint: " << this->FrameFingerprint << "\n";
+  os << indent << "FrameMismatches: " << this->GetNumberOfFrameMismatches() << "\n";
   os << indent << "SessionTimeout: " << this->SessionTimeout << " s\n";
   os << indent << "InjectedDelay: " << this->InjectedDelay << " s\n";
   os << indent << "InjectedLossRate: " << this->InjectedLossRate << "\n";

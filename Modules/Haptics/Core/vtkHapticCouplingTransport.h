@@ -7,8 +7,16 @@
  * Forces forwarded between an instructor's and a trainee's haptic loop need
  * their own 1 kHz stream, not OpenIGTLink: one small datagram per tick each
  * way. Each packet carries the sender's proxy state and the energy it has
- * shipped so far (vtkHapticCoupling), in a versioned layout (State, 96 bytes,
- * little-endian) ending with a CRC-32 of everything before it.
+ * shipped so far (vtkHapticCoupling), in a versioned layout (State, 104
+ * bytes, little-endian) ending with a CRC-32 of everything before it.
+ *
+ * The frame the positions are in: each packet carries the sender's
+ * FrameFingerprint, 0 for a device's own millimetres (two free devices) or
+ * ComputeFrameFingerprint of the scan whose RAS millimetres both drilling
+ * sessions share. A valid packet with another fingerprint than this side's
+ * is refused and counted (the two sides drill different scans, or one
+ * drills and the other holds a free device): its positions mean other
+ * places, so no spring may act on them.
  *
  * Never blocks the tick: the socket is non-blocking; Send gives up (counted)
  * rather than wait for buffer space, ReceiveLatest drains what arrived and
@@ -40,6 +48,9 @@
 #include <memory> // For the internals
 #include <string> // For GetPeerAddress
 
+class vtkImageData;
+class vtkMatrix4x4;
+
 class VTK_VOLUMECUTTINGHAPTICS_EXPORT vtkHapticCouplingTransport : public vtkObject
 {
 public:
@@ -48,9 +59,9 @@ public:
   void PrintSelf(ostream& os, vtkIndent indent) override;
 
   /// The packet layout's version; a packet of another version is refused.
-  static constexpr int ProtocolVersion = 1;
+  static constexpr int ProtocolVersion = 2;
   /// Size of an encoded packet (bytes).
-  static constexpr int PacketSize = 96;
+  static constexpr int PacketSize = 104;
 
 #ifndef __VTK_WRAP__
   /// What one packet carries (positions RAS mm, velocities mm/s, energies mJ = N mm).
@@ -70,6 +81,8 @@ public:
     double Tank = 0.0;
     /// PresentFlag: the sender's device has a pose.
     unsigned int Flags = 0;
+    /// The frame Position and Velocity are in (see FrameFingerprint).
+    unsigned long long Frame = 0;
   };
   static constexpr unsigned int PresentFlag = 1u;
 
@@ -135,6 +148,37 @@ public:
 
   ///@{
   /**
+   * Set/get the frame this side's positions are in, sent in every packet;
+   * packets in another frame are refused. 0 (default): the device's own
+   * millimetres; otherwise ComputeFrameFingerprint of the shared scan. Set
+   * while the haptic thread does not send.
+   */
+  vtkSetMacro(FrameFingerprint, unsigned long long);
+  vtkGetMacro(FrameFingerprint, unsigned long long);
+  ///@}
+
+  /**
+   * A fingerprint of a scan's RAS frame and content: its dimensions, its
+   * IJK-to-RAS matrix (spacing, origin, axes), its scalar type and a 64-bit
+   * FNV-1a checksum of its samples. Two sessions that loaded the same scan
+   * get the same value on any machine; a scan that differs in any of these
+   * (another patient, a resampled or cropped copy) almost surely another.
+   * Never 0 for an image with samples (0 means "no scan"); 0 for nullptr or
+   * an image without scalars.
+   */
+  static unsigned long long ComputeFrameFingerprint(vtkImageData* anatomy, vtkMatrix4x4* ijkToRAS);
+
+  ///@{
+  /**
+   * Valid packets refused because their frame differs from this side's,
+   * and the frame the last of them carried (0: none so far).
+   */
+  unsigned long long GetNumberOfFrameMismatches() const;
+  unsigned long long GetLastRefusedFrame() const;
+  ///@}
+
+  ///@{
+  /**
    * Set/get the time (s) without a packet after which a packet from another
    * session is taken as the peer's restart. Default is 0.5.
    */
@@ -177,6 +221,7 @@ protected:
   ~vtkHapticCouplingTransport() override;
 
   double SessionTimeout = 0.5;
+  unsigned long long FrameFingerprint = 0;
   double InjectedDelay = 0.0;
   double InjectedLossRate = 0.0;
   unsigned long long InjectionSeed = 1;

@@ -91,3 +91,28 @@ def test_devices_that_cannot_drive_the_drill_are_refused_with_a_reason():
     refused(drilling, cut, inputdevices.MOUSE_DEVICE_ID, "not plugged in", renderer=renderer, interactor=interactor,
             foot_switch="/dev/hidraw-pedal-gone")
     assert logic.GetRemovedVolume(cut) == 0.0
+
+
+def test_the_drill_takes_a_force_coupling_and_gives_it_back_at_stop():
+    """The desktop Drill coupled to an instructor: attached before the loop starts, detached when it stops; a port
+    in use stops the Drill from starting and leaves nothing running."""
+    from VolumeCuttingLib.collaboration import forcecoupling
+
+    application, logic, cut = block_scene()
+    place(add_burr(application.scene, cut), START)
+    renderer, window, interactor = view()
+    frame = forcecoupling.scan_fingerprint(cut.GetAnatomyVolumeNode())
+    drilling = HapticDrilling(logic)
+    end = forcecoupling.ForceCoupling(forcecoupling.CouplingSettings(local_port=0, peer_port=0, frame_fingerprint=frame))
+    drilling.start(cut, inputdevices.MOUSE_DEVICE_ID, renderer, interactor, coupling=end)
+    try:
+        assert drilling.running and drilling.session.GetLoop().GetCoupling() is end.coupling
+        assert end.status()["frame"] == frame and end.transport.IsOpen()
+        taken = forcecoupling.ForceCoupling(forcecoupling.CouplingSettings(local_port=end.local_port, peer_port=0))
+        second = HapticDrilling(logic)
+        refused(second, cut, inputdevices.MOUSE_DEVICE_ID, "could not bind", renderer=renderer, interactor=interactor,
+                coupling=taken)
+        assert second.coupling is None
+    finally:
+        drilling.stop()
+    assert not end.transport.IsOpen() and drilling.coupling is None

@@ -19,6 +19,7 @@
 
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
+#include <vtkMath.h>
 #include <vtkNew.h>
 
 #include <algorithm>
@@ -41,27 +42,11 @@ int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   // The protected ball (label 1) sits on the hand's circle below the plane;
   // the test scene maps RAS x = 12 - 0.5 i, y = -12 + 0.5 j, z = -12 + 0.5 k.
   vtkNew<vtkImageData> labels;
-  labels->SetDimensions(scene.Size, scene.Size, scene.Size);
-  labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
   const double ballCenter[3] = { -3.0, 0.0, -1.5 };
   const double ballRadius = 1.0;
-  vtkIdType protectedVoxels = 0;
-  for (int k = 0; k < scene.Size; ++k)
-  {
-    for (int j = 0; j < scene.Size; ++j)
-    {
-      for (int i = 0; i < scene.Size; ++i)
-      {
-        const double ijk[4] = { double(i), double(j), double(k), 1.0 };
-        double ras[4];
-        scene.IJKToRAS->MultiplyPoint(ijk, ras);
-        const double dx = ras[0] - ballCenter[0], dy = ras[1] - ballCenter[1], dz = ras[2] - ballCenter[2];
-        const bool inside = dx * dx + dy * dy + dz * dz <= ballRadius * ballRadius;
-        *static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) = inside ? 1 : 0;
-        protectedVoxels += inside ? 1 : 0;
-      }
-    }
-  }
+  const vtkIdType protectedVoxels = scene.MakeLabels(labels, [&](const double ras[3]) {
+    return vtkMath::Distance2BetweenPoints(ras, ballCenter) <= ballRadius * ballRadius;
+  });
   CHECK_BOOL(protectedVoxels > 0, true);
   CHECK_BOOL(scene.Field->SetProtectedLabels(labels), true);
 
@@ -176,23 +161,7 @@ int vtkHapticLoopThreadTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_BOOL(scene.Field->GetNumberOfUndoSteps() <= loop->GetNumberOfDrillPresses(), true);
   CHECK_INT(loop->GetNumberOfDrillPresses(), loop->GetNumberOfDrillReleases());
   // Nothing of the protected ball was removed by the cutter's strokes.
-  int protectedRemoved = 0;
-  for (int k = 0; k < scene.Size; ++k)
-  {
-    for (int j = 0; j < scene.Size; ++j)
-    {
-      for (int i = 0; i < scene.Size; ++i)
-      {
-        if (*static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) != 0)
-        {
-          const double ijk[4] = { double(i), double(j), double(k), 1.0 };
-          double ras[4];
-          scene.IJKToRAS->MultiplyPoint(ijk, ras);
-          protectedRemoved += scene.Field->GetSignedDistance(ras) > 0.0 ? 0 : 1;
-        }
-      }
-    }
-  }
+  const int protectedRemoved = scene.CountRemovedLabelled(labels, scene.Field);
   CHECK_INT(protectedRemoved, 0);
   CHECK_BOOL(consistent.load(), true);
   CHECK_BOOL(cuts > 0, true);

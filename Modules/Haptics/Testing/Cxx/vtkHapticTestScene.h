@@ -15,6 +15,8 @@
 #include <vtkPointData.h>
 #include <vtkVolumeCutField.h>
 
+#include <functional>
+
 struct vtkHapticTestScene
 {
   /// Voxel edge (mm), the plane's height (RAS z, mm), the iso-value.
@@ -54,6 +56,50 @@ struct vtkHapticTestScene
     this->CT->GetPointData()->SetScalars(values);
     const int dims[3] = { this->Size, this->Size, this->Size };
     this->Field->Initialize(dims, this->IJKToRAS, 2);
+  }
+
+  /// A label image on the scene's grid: 1 where inside(RAS) holds, else 0. Returns how many voxels are labelled.
+  vtkIdType MakeLabels(vtkImageData* labels, const std::function<bool(const double ras[3])>& inside) const
+  {
+    labels->SetDimensions(this->Size, this->Size, this->Size);
+    labels->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+    vtkIdType count = 0;
+    this->ForEachVoxel([&](int i, int j, int k, const double ras[3]) {
+      const bool in = inside(ras);
+      *static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) = in ? 1 : 0;
+      count += in ? 1 : 0;
+    });
+    return count;
+  }
+
+  /// Labelled voxels whose centre a field shows removed (its signed distance there not positive).
+  int CountRemovedLabelled(vtkImageData* labels, vtkVolumeCutField* field) const
+  {
+    int removed = 0;
+    this->ForEachVoxel([&](int i, int j, int k, const double ras[3]) {
+      if (*static_cast<unsigned char*>(labels->GetScalarPointer(i, j, k)) != 0)
+      {
+        removed += field->GetSignedDistance(ras) > 0.0 ? 0 : 1;
+      }
+    });
+    return removed;
+  }
+
+  void ForEachVoxel(const std::function<void(int, int, int, const double[3])>& visit) const
+  {
+    for (int k = 0; k < this->Size; ++k)
+    {
+      for (int j = 0; j < this->Size; ++j)
+      {
+        for (int i = 0; i < this->Size; ++i)
+        {
+          const double ijk[4] = { double(i), double(j), double(k), 1.0 };
+          double ras[4];
+          this->IJKToRAS->MultiplyPoint(ijk, ras);
+          visit(i, j, k, ras);
+        }
+      }
+    }
   }
 };
 

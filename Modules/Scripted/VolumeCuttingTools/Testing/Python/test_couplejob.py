@@ -134,6 +134,9 @@ def test_an_instructor_whose_trainee_never_answers_is_told_what_to_do(tmp_path, 
     (["--couple-listen", "47000", "--couple-host", "256.1.1.1"], "--couple-host"),
     (["--couple-listen", "47000", "--couple-stiffness", "0"], "--couple-stiffness"),
     (["--device", "virtual"], "say which side this is"),
+    (["--couple-listen", "47000", "--segmentation", "anatomy.seg.nrrd"], "go with --ct"),
+    (["--couple-listen", "47000", "--ct", "ct.nrrd", "--tool-at", "1,2"], "give R,A,S"),
+    (["--couple-listen", "47000", "--ct", "ct.nrrd", "--device-scale", "0"], "--device-scale"),
 ])
 def test_a_bad_address_or_setting_is_refused_with_a_message(arguments, message, capsys):
     with pytest.raises(SystemExit) as stopped:
@@ -150,3 +153,48 @@ def test_a_port_in_use_is_reported_and_nothing_is_left_running(capsys):
     finally:
         taken.detach()
     assert "could not bind UDP 127.0.0.1:" in capsys.readouterr().err
+
+
+def write_block_ct(path, bump: int = 0) -> None:
+    """A 16-voxel cube of bone in air, as NRRD; ``bump`` changes one voxel (another scan)."""
+    ct = np.full((16, 16, 16), -1000, np.int16)
+    ct[4:12, 4:12, 4:12] = 1200
+    ct[1, 1, 1] += bump
+    header = ("NRRD0004\ntype: short\ndimension: 3\nspace: right-anterior-superior\nsizes: 16 16 16\n"
+              "space directions: (0.5,0,0) (0,0.5,0) (0,0,0.5)\nkinds: domain domain domain\nendian: little\n"
+              "encoding: raw\nspace origin: (-4,-4,-4)\n\n")
+    path.write_bytes(header.encode() + ct.astype("<i2").tobytes())
+
+
+def test_an_instructor_on_another_scan_is_refused_and_told_why(tmp_path, capsys):
+    """The instructor's side loads a CT with one voxel changed: the trainee's packets are refused, it ends saying so."""
+    write_block_ct(tmp_path / "trainee.nrrd")
+    write_block_ct(tmp_path / "other.nrrd", bump=1)
+    volume = slicer.vtkMRMLScalarVolumeNode()
+    reader = slicer.vtkMRMLVolumeArchetypeStorageNode()
+    reader.SetFileName(str(tmp_path / "trainee.nrrd"))
+    assert reader.ReadData(volume)
+    frame = forcecoupling.scan_fingerprint(volume)
+    # The trainee's side: a free loop in the trainee's scan's frame, listening (its drilling is not what is tested).
+    trainee = forcecoupling.ForceCoupling(forcecoupling.CouplingSettings(local_port=0, peer_port=0, frame_fingerprint=frame))
+    device = slicer.vtkVirtualHapticDevice()
+    assert device.Open()
+    device.SetPose([0.0, 0.0, 0.0], 0)
+    loop = slicer.vtkHapticLoop()
+    loop.SetDevice(device)
+    loop.SetForceModel(forcecoupling.air_force_model())
+    trainee.attach(loop)
+    assert loop.Start()
+    try:
+        code = couplejob.main(["--couple-to", f"127.0.0.1:{trainee.local_port}", "--device", "virtual",
+                               "--ct", str(tmp_path / "other.nrrd"), "--couple-wait", "5",
+                               "--summary", str(tmp_path / "instructor.json")])
+    finally:
+        loop.Stop()
+        status = trainee.status()
+        trainee.detach()
+    assert code == 3
+    error = capsys.readouterr().err
+    assert f"the trainee loaded another scan (fingerprint {frame:016x})" in error and "Load the same CT" in error
+    assert status["packets_accepted"] == 0 and status["frame_mismatches"] > 0
+    assert "another scan" in json.loads((tmp_path / "instructor.json").read_text())["error"]

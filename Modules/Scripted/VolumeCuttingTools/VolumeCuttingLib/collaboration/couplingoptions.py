@@ -17,7 +17,7 @@ import socket
 import time
 from dataclasses import dataclass
 
-from .forcecoupling import LOOPBACK, CouplingSettings
+from .forcecoupling import LOOPBACK, CouplingSettings, describe_mismatch
 
 TRAINEE = "trainee"
 INSTRUCTOR = "instructor"
@@ -47,13 +47,14 @@ class CouplingOptions:
     def joins(self) -> bool:
         return self.role == INSTRUCTOR
 
-    def settings(self) -> CouplingSettings:
-        """The coupling's settings for this side (the trainee's listens: peer port 0)."""
+    def settings(self, frame_fingerprint: int = 0) -> CouplingSettings:
+        """The coupling's settings for this side (the trainee's listens: peer port 0), in the frame of the scan
+        whose fingerprint is given (0: the devices' own millimetres)."""
         if self.joins:
             return CouplingSettings(local_port=0, peer_port=self.port, host=self.host, peer_host=self.peer_host,
-                                    stiffness=self.stiffness)
+                                    stiffness=self.stiffness, frame_fingerprint=frame_fingerprint)
         return CouplingSettings(local_port=self.port, peer_port=0, host=self.host, peer_host="0.0.0.0",
-                                stiffness=self.stiffness)
+                                stiffness=self.stiffness, frame_fingerprint=frame_fingerprint)
 
     def describe(self) -> str:
         if self.joins:
@@ -139,6 +140,7 @@ class PeerWatch:
         self.events: list[dict] = []
         self.joined = False
         self.present = False
+        self.mismatch = None
         self._started = time.perf_counter()
 
     def elapsed(self) -> float:
@@ -157,6 +159,10 @@ class PeerWatch:
             self._event(f"{peer} is gone (nothing for {PEER_GONE_S:g} s): its pull faded out; this side goes on and "
                         "takes it back when it returns", say)
             self.present = False
+        if self.mismatch is None:
+            self.mismatch = describe_mismatch(status, peer)
+            if self.mismatch:
+                self._event(self.mismatch, say)
         return status
 
     def never_answered(self) -> str | None:
@@ -167,6 +173,10 @@ class PeerWatch:
         return (f"no trainee answered at {self.options.peer_host}:{port} within {self.options.answer_timeout_s:g} s: "
                 f"start the trainee's side first (--couple-listen {port}), check the address, and that UDP port {port} "
                 "is open between the machines (a firewall refuses it silently)")
+
+    def refused(self) -> str | None:
+        """On the joining side, once the trainee's side was refused for its scan: what to tell the user."""
+        return self.mismatch if self.options.joins and not self.joined else None
 
     def _event(self, what: str, say) -> None:
         self.events.append({"t_s": round(self.elapsed(), 3), "event": what})

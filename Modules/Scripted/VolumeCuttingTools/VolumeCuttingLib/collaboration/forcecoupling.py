@@ -10,6 +10,16 @@ proxies, under an energy-tank passivity layer (see the C++ classes and
 
 ``ForceCoupling`` configures one end and attaches it to a stopped loop (the
 logic's haptic session exposes its loop: ``session.GetLoop()``).
+
+Two drilling sessions are coupled in the scan's RAS millimetres: the loop
+hands the coupling its tool's proxy in RAS (each side through its own
+device-to-RAS placement, rotation and scale included) and maps the spring's
+force back into its device's axes. Both ends then carry the scan's
+fingerprint (``scan_fingerprint``: dimensions, IJK-to-RAS, a checksum of the
+samples) in every packet, and refuse a peer whose fingerprint differs: its
+positions would be places in another scan. ``guide_loop`` makes the
+instructor's side of such a pair: a device held over air in the same scan's
+RAS, which feels the trainee's tool and pulls it.
 ``rehearse`` runs two coupled loops with simulated hands on loopback, ticked
 in lockstep on the calling thread, with injected delay and loss: the
 figures that tell whether a setting is stable (the benchmark area
@@ -43,6 +53,7 @@ class CouplingSettings:
     injected_delay_s: float = 0.0   # one-way, on this end's outgoing packets
     injected_loss: float = 0.0      # fraction of this end's outgoing packets dropped
     seed: int = 1                   # of the loss generator
+    frame_fingerprint: int = 0      # 0: the devices' own mm; else scan_fingerprint of the scan both sides drill
 
     def validate(self) -> None:
         """Raise ValueError naming the first setting that cannot work."""
@@ -62,6 +73,30 @@ class CouplingSettings:
                 raise ValueError(f"{name} must be from {lowest} to {highest}, not {value!r}")
         if not isinstance(self.seed, int) or self.seed < 0:
             raise ValueError(f"seed must be a non-negative integer, not {self.seed!r}")
+        if not isinstance(self.frame_fingerprint, int) or not 0 <= self.frame_fingerprint < 2 ** 64:
+            raise ValueError("frame_fingerprint must be 0 (the devices' own millimetres) or scan_fingerprint(volume_node), "
+                             f"not {self.frame_fingerprint!r}")
+
+
+def scan_fingerprint(volume_node) -> int:
+    """The fingerprint of a scan's RAS frame and samples that two coupled drilling sessions must share (never 0)."""
+    image = volume_node.GetImageData() if volume_node is not None else None
+    if image is None or image.GetPointData().GetScalars() is None:
+        raise ValueError("the scan has no image data: load the CT before coupling its drilling session")
+    ijk_to_ras = vtk.vtkMatrix4x4()
+    volume_node.GetIJKToRASMatrix(ijk_to_ras)
+    return int(slicer.vtkHapticCouplingTransport.ComputeFrameFingerprint(image, ijk_to_ras))
+
+
+def describe_mismatch(status: dict, peer: str) -> str | None:
+    """What to tell the user when the peer's packets were refused for their frame; None when none were."""
+    if not status.get("frame_mismatches"):
+        return None
+    ours, theirs = status["frame"], status["refused_frame"]
+    what = {0: "holds a free device (no scan)"}.get(theirs, f"loaded another scan (fingerprint {theirs:016x})")
+    here = "this side holds a free device (no scan)" if ours == 0 else f"this side's scan has fingerprint {ours:016x}"
+    return (f"{peer} {what}; {here}. Refused: the two tools would be in different places. Load the same CT on both "
+            "sides (the same file: same dimensions, spacing, origin, axes and samples), or neither")
 
 
 class ForceCoupling:
@@ -88,6 +123,7 @@ class ForceCoupling:
         self.transport.SetInjectedDelay(settings.injected_delay_s)
         self.transport.SetInjectedLossRate(settings.injected_loss)
         self.transport.SetInjectionSeed(settings.seed)
+        self.transport.SetFrameFingerprint(settings.frame_fingerprint)
         if not self.transport.Open(settings.host, settings.local_port, settings.peer_host, settings.peer_port):
             peer = "any peer" if settings.peer_port == 0 else f"its peer at {settings.peer_host}:{settings.peer_port}"
             raise OSError(f"the force coupling could not bind UDP {settings.host}:{settings.local_port} for {peer} "
@@ -126,6 +162,9 @@ class ForceCoupling:
             "packets_garbled": transport.GetNumberOfGarbledPackets(),
             "packets_stale": transport.GetNumberOfStalePackets(),
             "packets_foreign": transport.GetNumberOfForeignSessionPackets() + transport.GetNumberOfForeignHostPackets(),
+            "frame": int(transport.GetFrameFingerprint()),
+            "frame_mismatches": transport.GetNumberOfFrameMismatches(),
+            "refused_frame": int(transport.GetLastRefusedFrame()),
         }
 
 
@@ -162,6 +201,25 @@ def air_force_model():
     model.SetAnatomy(image, vtk.vtkMatrix4x4())
     model.SetSphereRadius(2.0)
     return model
+
+
+def guide_loop(device, device_to_ras):
+    """The instructor's loop for coupling to a drilling session: ``device`` over air, placed in the scan's RAS.
+
+    ``device_to_ras`` (a vtkMatrix4x4: rotation, uniform scale, translation)
+    places the device in the scan as the trainee's session places its own
+    (by default the session puts the device's centre where the tool is, axes
+    along RAS). The tool touches nothing: the instructor feels the trainee's
+    tool, and its contacts, only through the coupling. Returns (loop, model).
+    """
+    loop = slicer.vtkHapticLoop()
+    loop.SetRate(1000.0)
+    loop.SetDevice(device)
+    model = air_force_model()
+    loop.SetForceModel(model)
+    if not loop.SetDeviceToRAS(device_to_ras):
+        raise ValueError("the device's placement in the scan must be a rotation, a uniform scale and a translation")
+    return loop, model
 
 
 def rehearse(delay_s: float, loss: float, seconds: float = 4.0, passivity: bool = True, seed: int = 1) -> dict:

@@ -78,6 +78,7 @@ class HapticDrilling:
         self.device = None
         self.foot_switch = None
         self.mouse_driver = None
+        self.coupling = None
 
     @property
     def running(self) -> bool:
@@ -89,13 +90,17 @@ class HapticDrilling:
         return self.running and bool(self.session.GetLoop().GetDrilling())
 
     def start(self, cut_node, device, renderer=None, interactor=None, foot_switch=None, falcon_firmware=None,
-              device_scale: float = 1.0) -> None:
+              device_scale: float = 1.0, coupling=None) -> None:
         """Start drilling ``cut_node`` with its active tool, moved by ``device`` (an InputDevice or a device_id).
 
         The mouse needs the 3D view's ``renderer`` and ``interactor``; a
         Falcon needs ``falcon_firmware``, the firmware file the user has (it
         is not shipped); ``foot_switch`` (optional) runs the drill as well
-        as the device's own button. Raises HapticDrillingError.
+        as the device's own button. ``coupling`` (optional, a
+        ``collaboration.forcecoupling.ForceCoupling`` made with the CT's
+        ``scan_fingerprint``) couples the session's loop to a peer's: it is
+        attached before the loop starts and detached when the session stops.
+        Raises HapticDrillingError.
         """
         if self.running:
             raise HapticDrillingError("a drilling session is running already: stop it first")
@@ -112,6 +117,12 @@ class HapticDrilling:
             for watched in (session, session.GetLoop(), self.device, self.foot_switch):
                 if watched is not None:
                     collector.watch(watched)
+            if coupling is not None:
+                try:
+                    coupling.attach(session.GetLoop())
+                except OSError as error:
+                    raise HapticDrillingError(str(error)) from None
+                self.coupling = coupling
             started = (session.Start(cut_node, self.device, self.foot_switch) if self.foot_switch is not None
                        else session.Start(cut_node, self.device))
             if not started:
@@ -142,6 +153,9 @@ class HapticDrilling:
         if self.session is not None:
             self.session.Stop()
             self.session = None
+        if self.coupling is not None:
+            self.coupling.detach()
+            self.coupling = None
         for device in (self.device, self.foot_switch):
             if device is not None and device.IsConnected():
                 device.Close()

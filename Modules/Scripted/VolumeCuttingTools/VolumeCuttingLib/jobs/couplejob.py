@@ -16,6 +16,17 @@ Nothing here can be lost: a peer that goes away (its process ends, the
 network drops) is reported and its pull fades out within 0.15 s, the loop
 goes on and takes the peer back if it returns. The instructor's side gives up
 with a clear message when the trainee's side never answers (``--couple-wait``).
+With ``--ct FILE`` on both sides the two are drilling sessions on that scan,
+coupled in its RAS millimetres: the trainee's side drills it (the logic's
+haptic session: the cut, the protection of ``--protected`` segments of
+``--segmentation``, and the force model act on the trainee's tool as ever),
+the instructor's side holds its device over air in the same scan and feels
+the trainee's tool, its contacts included, through the spring. Each side
+places its device's centre at ``--tool-at R,A,S`` (default: the scan's
+centre), axes along RAS, ``--device-scale`` scene mm per device mm. Each packet
+carries the scan's fingerprint; a side that loaded another scan (or none) is
+refused and told so, and the instructor's side ends.
+
 ``--device virtual`` holds a virtual device still (try the link without a
 device); ``--device replay --replay FILE`` plays a recorded hand
 (``vtkHapticRecorder`` file). ``--summary PATH`` writes what the device felt.
@@ -33,8 +44,13 @@ from pathlib import Path
 
 import slicer
 
+import vtk
+
 from ..collaboration import couplingoptions, forcecoupling
 from ..config import inputdevices
+from ..data import owndata
+from ..scene.application import HeadlessSlicer
+from . import hapticsjob
 
 #: How often the job looks at the coupling (s): the events it prints and the force samples of the summary.
 WATCH_PERIOD_S = 0.01
@@ -72,17 +88,24 @@ def open_device(kind: str, falcon_firmware: Path | None = None, replay: Path | N
 
 
 class CoupledDevice:
-    """A device on a haptic loop over air, coupled to a peer: what ``main`` runs."""
+    """A device on a haptic loop, coupled to a peer: over air (no scan), or on a scan (``DrilledScan``)."""
 
-    def __init__(self, options: couplingoptions.CouplingOptions, device):
+    def __init__(self, options: couplingoptions.CouplingOptions, device, scan=None):
         self.options = options
         self.device = device
-        self.loop = slicer.vtkHapticLoop()
-        self.loop.SetRate(1000.0)
-        self.loop.SetDevice(device)
-        self._model = forcecoupling.air_force_model()  # nothing to touch but the peer's tool
-        self.loop.SetForceModel(self._model)
-        self.end = forcecoupling.ForceCoupling(options.settings())
+        self.scan = scan
+        self.end = forcecoupling.ForceCoupling(options.settings(scan.fingerprint if scan is not None else 0))
+        self.drills = scan is not None and not options.joins
+        if self.drills:
+            self.loop = scan.session.GetLoop()  # the trainee drills: the logic's haptic session's loop
+        elif scan is not None:
+            self.loop, self._model = forcecoupling.guide_loop(device, scan.device_to_ras())
+        else:
+            self.loop = slicer.vtkHapticLoop()
+            self.loop.SetRate(1000.0)
+            self.loop.SetDevice(device)
+            self._model = forcecoupling.air_force_model()  # nothing to touch but the peer's tool
+            self.loop.SetForceModel(self._model)
         self.peers = couplingoptions.PeerWatch(options, self.end)
         self.samples: list[tuple] = []
         self._started = None
@@ -98,7 +121,8 @@ class CoupledDevice:
             raise CouplingError(f"the device could not be opened: {self.device.GetLastErrorMessage() or 'see the log'}")
         if isinstance(self.device, slicer.vtkVirtualHapticDevice):
             self.device.SetPose([0.0, 0.0, 0.0], 0)
-        if not self.loop.Start():
+        started = self.scan.session.Start(self.scan.cut_node, self.device) if self.drills else self.loop.Start()
+        if not started:
             self.device.Close()
             self.end.detach()
             raise CouplingError("the haptic loop could not start (see the log)")
@@ -118,13 +142,17 @@ class CoupledDevice:
         if len(self.samples) < MAXIMUM_SAMPLES:
             self.samples.append((round(self.elapsed(), 4), *(round(f, 4) for f in force), round(status["peer_age_s"], 4),
                                  round(status["gain"], 4)))
-        problem = self.peers.never_answered()
+        if self.drills:
+            self.scan.session.Update()  # the tool node and the cut node's events, at this display rate
+        problem = self.peers.never_answered() or self.peers.refused()
         if problem:
             raise CouplingError(problem)
         return status
 
     def stop(self) -> dict:
         """Stop the loop, close the socket and the device; the figures."""
+        if self.drills:
+            self.scan.session.Stop()  # closes the open stroke and brings the logic's tables up to date
         self.loop.Stop()
         status = self.end.status()
         self.end.detach()
@@ -140,10 +168,84 @@ class CoupledDevice:
             "device_force_limit_N": self.device.GetCapabilities().GetMaximumForce(),
             "largest_force_N": round(max(forces, default=0.0), 4),
             "events": self.peers.events,
+            "scan": self.scan.describe() if self.scan is not None else None,
             "status": status,
             "samples_columns": ["t_s", "fx_N", "fy_N", "fz_N", "peer_age_s", "gain"],
             "samples": self.samples,
         }
+
+
+class DrilledScan:
+    """The scan both sides load: its fingerprint, where the devices are placed in it, and the trainee's drilling."""
+
+    def __init__(self, ct: Path, drills: bool, segmentation: Path | None = None, protected: str = "",
+                 tool_at=None, device_scale: float = 1.0):
+        self.application = HeadlessSlicer()
+        scene = self.application.scene
+        try:
+            self.volume = owndata.load_ct(scene, ct)
+            segmentation_node = owndata.load_segmentation(scene, segmentation, self.volume) if segmentation else None
+        except owndata.InputError as error:
+            raise CouplingError(str(error)) from None
+        self.ct = ct
+        self.fingerprint = forcecoupling.scan_fingerprint(self.volume)
+        bounds = [0.0] * 6
+        self.volume.GetRASBounds(bounds)
+        self.tool_at = list(tool_at) if tool_at is not None else [(bounds[2 * a] + bounds[2 * a + 1]) / 2.0 for a in range(3)]
+        self.device_scale = device_scale
+        self.session = self.cut_node = None
+        if not drills:
+            return
+        logic = self.application.volume_cutting_logic
+        if segmentation_node is None:
+            segmentation_node = logic.CreateBoneSegmentation(self.volume, 700.0, 200.0, 0.5)
+            if segmentation_node is None:
+                raise CouplingError(f"no bone could be segmented in {ct} (is it a CT in HU?)")
+        segments = segmentation_node.GetSegmentation()
+        names = [segments.GetSegment(s).GetName() for s in segments.GetSegmentIDs()]
+        protected_names = [n.strip() for n in protected.split(",") if n.strip()]
+        try:
+            cuttable, protected_ids = owndata.resolve_roles(
+                segmentation_node, [n for n in names if n.lower() not in {p.lower() for p in protected_names}],
+                protected_names)
+        except owndata.InputError as error:
+            raise CouplingError(str(error)) from None
+        self.cut_node = logic.AddVolumeCutNode(self.volume, segmentation_node)
+        self.cut_node.SetCuttableSegmentIDs(cuttable)
+        self.cut_node.SetProtectedSegmentIDs(protected_ids)
+        tool, _ = hapticsjob.active_burr(scene, self.cut_node)
+        start = vtk.vtkMatrix4x4()
+        for axis in range(3):
+            start.SetElement(axis, 3, self.tool_at[axis])
+        tool.GetParentTransformNode().SetMatrixTransformToParent(start)
+        self.session = slicer.vtkSlicerVolumeCuttingHapticSession()
+        self.session.SetLogic(logic)
+        self.session.SetDeviceScale(device_scale)
+
+    def device_to_ras(self):
+        """The device's placement in the scan, as the trainee's session makes it: centre at tool_at, axes along RAS."""
+        matrix = vtk.vtkMatrix4x4()
+        for axis in range(3):
+            matrix.SetElement(axis, axis, self.device_scale)
+            matrix.SetElement(axis, 3, self.tool_at[axis])
+        return matrix
+
+    def describe(self) -> dict:
+        described = {"ct": str(self.ct), "fingerprint": f"{self.fingerprint:016x}", "tool_at_ras_mm": self.tool_at}
+        if self.cut_node is not None:
+            described["removed_mm3"] = round(self.application.volume_cutting_logic.GetRemovedVolume(self.cut_node), 3)
+        return described
+
+
+def _point(text: str):
+    parts = str(text).split(",")
+    try:
+        values = [float(part) for part in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(f"{text!r}: give R,A,S in millimetres, such as 10,-4.5,22")
+    return values
 
 
 def main(argv=None) -> int:
@@ -157,6 +259,19 @@ def main(argv=None) -> int:
     parser.add_argument("--seconds", type=float, default=0.0,
                         help="stop after this long (default: until Ctrl-C, or the end of a replayed recording)")
     parser.add_argument("--summary", type=Path, default=None, help="write what the device felt here (JSON)")
+    scan = parser.add_argument_group("coupled drilling", "both sides load the same CT: the trainee drills it, the "
+                                     "instructor feels the trainee's tool in it and guides it")
+    scan.add_argument("--ct", type=Path, default=None,
+                      help="the CT both sides load (the same file: a side with another scan, or none, is refused)")
+    scan.add_argument("--segmentation", type=Path, default=None,
+                      help="trainee's side: its segments (default: the bone the CT shows); all are cut but --protected")
+    scan.add_argument("--protected", default="", metavar="NAMES",
+                      help="trainee's side: segments of --segmentation the drill may not cut (comma-separated)")
+    scan.add_argument("--tool-at", type=_point, default=None, metavar="R,A,S",
+                      help="where each side's device centre is placed in the CT (default: its centre); give the same "
+                           "on both sides, so that the tools coincide when the hands do")
+    scan.add_argument("--device-scale", type=float, default=1.0,
+                      help="scene mm per device mm (default 1; the same on both sides)")
     args = parser.parse_args(argv)
     try:
         options = couplingoptions.options_from_arguments(args)
@@ -165,6 +280,10 @@ def main(argv=None) -> int:
     if options is None:
         parser.error("say which side this is: --couple-listen PORT (the trainee's, waits) or --couple-to HOST:PORT "
                      "(the instructor's, joins)")
+    if args.ct is None and (args.segmentation or args.protected or args.tool_at):
+        parser.error("--segmentation, --protected and --tool-at go with --ct")
+    if not (math.isfinite(args.device_scale) and 0.01 <= args.device_scale <= 100.0):
+        parser.error(f"--device-scale {args.device_scale}: give 0.01 to 100 scene mm per device mm")
     if args.seconds < 0 or not math.isfinite(args.seconds):
         parser.error(f"--seconds {args.seconds}: give a time of 0 (until Ctrl-C) or more")
 
@@ -175,7 +294,12 @@ def main(argv=None) -> int:
     failure = None
     try:
         device = open_device(args.device, args.falcon_firmware, args.replay)
-        coupled = CoupledDevice(options, device)
+        drilled = None
+        if args.ct is not None:
+            drilled = DrilledScan(args.ct, drills=not options.joins, segmentation=args.segmentation,
+                                  protected=args.protected, tool_at=args.tool_at, device_scale=args.device_scale)
+            print(f"coupling: scan {args.ct}, fingerprint {drilled.fingerprint:016x}", flush=True)
+        coupled = CoupledDevice(options, device, drilled)
         port = coupled.start()
         where = (f"waiting for the instructor on {options.host}:{port} (they join with --couple-to HOST:{port})"
                  if not options.joins else f"joining the trainee at {options.peer_host}:{options.port}")
