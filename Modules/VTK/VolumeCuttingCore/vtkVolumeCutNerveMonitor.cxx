@@ -632,30 +632,28 @@ double vtkVolumeCutNerveMonitor::GetFiringRateOfDistance(double distance) const
 //------------------------------------------------------------------------------
 double vtkVolumeCutNerveMonitor::GetDistanceAt(int index, const double ras[3]) const
 {
-  Internals::ReadGuard guard(*this->Internal);
-  const vtkVolumeCutNerveMonitorSnapshot& snapshot = *guard.Snapshot;
-  if (index < 0 || index >= static_cast<int>(snapshot.Fields.size()) || !snapshot.Fields[index])
-  {
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  double ijk[3];
-  snapshot.ToIJK(ras, ijk);
-  return snapshot.Fields[index]->GetDistance(ijk);
+  double surface, shield;
+  return this->GetDistancesAt(index, ras, surface, shield) ? surface : std::numeric_limits<double>::quiet_NaN();
 }
 
 double vtkVolumeCutNerveMonitor::GetClearanceAt(int index, const double ras[3]) const
+{
+  double surface, shield;
+  return this->GetDistancesAt(index, ras, surface, shield) ? shield : std::numeric_limits<double>::quiet_NaN();
+}
+
+bool vtkVolumeCutNerveMonitor::GetDistancesAt(int index, const double ras[3], double& surface, double& shield) const
 {
   Internals::ReadGuard guard(*this->Internal);
   const vtkVolumeCutNerveMonitorSnapshot& snapshot = *guard.Snapshot;
   if (index < 0 || index >= static_cast<int>(snapshot.Fields.size()) || !snapshot.Fields[index])
   {
-    return std::numeric_limits<double>::quiet_NaN();
+    return false;
   }
   double ijk[3];
   snapshot.ToIJK(ras, ijk);
-  double surface, shield;
   snapshot.Fields[index]->GetDistances(ijk, surface, shield);
-  return shield;
+  return true;
 }
 
 //------------------------------------------------------------------------------

@@ -276,6 +276,9 @@ protected:
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
+  /// Both distances of structure index at a RAS point; false before its field is built or for an unknown index.
+  bool GetDistancesAt(int index, const double ras[3], double& surface, double& shield) const;
+
   double Range = 8.0;
   double ContactRange = 4.0;
   double Smoothing = 1.0;
