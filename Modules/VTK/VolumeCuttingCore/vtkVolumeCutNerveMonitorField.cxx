@@ -322,20 +322,20 @@ int32_t PackCubeReference(int32_t cube, int i, int j, int k, const int dims[3], 
 /// Surface points, and for every voxel the index of the nearest one found so far.
 struct FootPoints
 {
-  std::vector<float> X, Y, Z;
+  /// x, y, z of each point together: the sweeps read them at random, one cache line a point.
+  std::vector<float> Points;
   std::vector<int32_t> Nearest;
   std::vector<float> SquaredDistance;
 
   int32_t Add(const double p[3])
   {
-    this->X.push_back(static_cast<float>(p[0]));
-    this->Y.push_back(static_cast<float>(p[1]));
-    this->Z.push_back(static_cast<float>(p[2]));
-    return static_cast<int32_t>(this->X.size() - 1);
+    this->Points.insert(this->Points.end(), { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]) });
+    return static_cast<int32_t>(this->Points.size() / 3 - 1);
   }
   double SquaredDistanceTo(int32_t foot, const double p[3]) const
   {
-    const double dx = p[0] - this->X[foot], dy = p[1] - this->Y[foot], dz = p[2] - this->Z[foot];
+    const float* point = this->Points.data() + 3 * static_cast<size_t>(foot);
+    const double dx = p[0] - point[0], dy = p[1] - point[1], dz = p[2] - point[2];
     return dx * dx + dy * dy + dz * dz;
   }
   void Offer(vtkIdType voxel, int32_t foot, const double p[3])
@@ -577,7 +577,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   std::copy(spacing, spacing + 3, field->Spacing);
   field->Range = range;
   field->SurfaceIsCubes = !useSmoothed;
-  field->NumberOfFootPoints = feet.X.size();
+  field->NumberOfFootPoints = feet.Points.size() / 3;
   for (int axis = 0; axis < 3; ++axis)
   {
     // The smoothed surface may reach a voxel beyond the structure's voxels.
