@@ -200,7 +200,7 @@ struct CylinderErrors
 
 CylinderErrors CylinderError(const double spacing[3], double turnDegrees, const double axis[3], double radius, int positions)
 {
-  const double extent = 12.0; // mm: burr centres stay within 5 mm of the axis
+  const double extent = 9.0; // mm: burr centres stay within 4 mm of the axis
   const int dims[3] = { int(extent / spacing[0]), int(extent / spacing[1]), int(extent / spacing[2]) };
   Grid grid(dims, spacing, turnDegrees);
   Cylinder nerve;
@@ -357,7 +357,7 @@ int TestSphereAccuracyAndTools()
   CHECK_BOOL(clear >= 150, true);
   // Against the two surfaces found independently (the smoothed surface's
   // points, the exact distance to the voxel cubes) the fields are far closer.
-  const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 4);
+  const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 3);
   const std::vector<int> voxels = vtkVolumeCutNerveMonitorTesting::VoxelsOf(labels, 3);
   double worstSurface = 0.0, worstShield = 0.0;
   for (int n = 0; n < 60; ++n)
@@ -576,10 +576,10 @@ int TestBadInput()
 int TestThreadsAndCost()
 {
   const double spacing[3] = { 0.15, 0.15, 0.15 };
-  const int dims[3] = { 80, 80, 60 };
+  const int dims[3] = { 64, 64, 48 };
   Grid grid(dims, spacing, 10.0);
   vtkNew<vtkVolumeCutNerveMonitor> monitor;
-  monitor->SetRange(4.0);
+  monitor->SetRange(3.0);
   monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
   double centre[3];
   grid.Centre(centre);
@@ -588,8 +588,8 @@ int TestThreadsAndCost()
   {
     Cylinder nerve;
     const double angle = 2.0 * vtkMath::Pi() * n / 10.0;
-    nerve.Point[0] = centre[0] + 3.0 * std::cos(angle);
-    nerve.Point[1] = centre[1] + 3.0 * std::sin(angle);
+    nerve.Point[0] = centre[0] + 2.5 * std::cos(angle);
+    nerve.Point[1] = centre[1] + 2.5 * std::sin(angle);
     nerve.Point[2] = centre[2];
     nerve.Axis[0] = std::sin(angle);
     nerve.Axis[1] = 0.3;
@@ -625,7 +625,7 @@ int TestThreadsAndCost()
   std::vector<double> positions(3 * queries);
   for (double& value : positions)
   {
-    value = Random(random, -4.0, 4.0);
+    value = Random(random, -3.0, 3.0);
   }
   std::vector<double> microseconds(queries);
   for (int n = 0; n < queries; ++n)
