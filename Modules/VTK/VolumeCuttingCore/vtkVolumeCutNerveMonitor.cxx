@@ -482,6 +482,7 @@ int vtkVolumeCutNerveMonitor::Build()
   int dims[3];
   double spacing[3];
   const double range = this->Range;
+  const double contactRange = std::min(this->ContactRange, this->Range);
   const double smoothing = this->Smoothing;
   {
     std::lock_guard<std::mutex> lock(internal.ConfigurationMutex);
@@ -523,7 +524,7 @@ int vtkVolumeCutNerveMonitor::Build()
       vtkTemplateMacro(reader.ReadMask(static_cast<const VTK_TT*>(nullptr), origin, maskDims, mask));
     }
     std::shared_ptr<const vtkVolumeCutNerveMonitorField> field =
-      vtkVolumeCutNerveMonitorField::Build(mask.data(), maskDims, origin, spacing, labelBox, smoothing, range);
+      vtkVolumeCutNerveMonitorField::Build(mask.data(), maskDims, origin, spacing, labelBox, smoothing, range, contactRange);
     longest = std::max(longest, std::chrono::duration<double>(std::chrono::steady_clock::now() - structureStart).count());
     std::lock_guard<std::mutex> lock(internal.ConfigurationMutex);
     if (internal.Generation != generation)
@@ -631,15 +632,28 @@ double vtkVolumeCutNerveMonitor::GetFiringRateOfDistance(double distance) const
 //------------------------------------------------------------------------------
 double vtkVolumeCutNerveMonitor::GetDistanceAt(int index, const double ras[3]) const
 {
+  double surface, shield;
+  return this->GetDistancesAt(index, ras, surface, shield) ? surface : std::numeric_limits<double>::quiet_NaN();
+}
+
+double vtkVolumeCutNerveMonitor::GetClearanceAt(int index, const double ras[3]) const
+{
+  double surface, shield;
+  return this->GetDistancesAt(index, ras, surface, shield) ? shield : std::numeric_limits<double>::quiet_NaN();
+}
+
+bool vtkVolumeCutNerveMonitor::GetDistancesAt(int index, const double ras[3], double& surface, double& shield) const
+{
   Internals::ReadGuard guard(*this->Internal);
   const vtkVolumeCutNerveMonitorSnapshot& snapshot = *guard.Snapshot;
   if (index < 0 || index >= static_cast<int>(snapshot.Fields.size()) || !snapshot.Fields[index])
   {
-    return std::numeric_limits<double>::quiet_NaN();
+    return false;
   }
   double ijk[3];
   snapshot.ToIJK(ras, ijk);
-  return snapshot.Fields[index]->GetDistance(ijk);
+  snapshot.Fields[index]->GetDistances(ijk, surface, shield);
+  return true;
 }
 
 //------------------------------------------------------------------------------
@@ -654,7 +668,17 @@ int vtkVolumeCutNerveMonitor::Measure(const double centre[3], double radius, Rea
   {
     const vtkVolumeCutNerveMonitorField* field = snapshot.Fields[index].get();
     Reading& reading = readings[index];
-    reading.Distance = field ? field->GetDistance(ijk) - radius : std::numeric_limits<double>::quiet_NaN();
+    if (field)
+    {
+      double surface, shield;
+      field->GetDistances(ijk, surface, shield);
+      reading.Clearance = shield - radius;
+      reading.Distance = reading.Clearance > 0.0 ? surface - radius : reading.Clearance;
+    }
+    else
+    {
+      reading.Distance = reading.Clearance = std::numeric_limits<double>::quiet_NaN();
+    }
     reading.Level = snapshot.Level(reading.Distance);
     reading.FiringRate = snapshot.Rate(reading.Distance);
   }
@@ -774,21 +798,34 @@ int vtkVolumeCutNerveMonitor::MeasureTool(const double toolToRAS[16], Reading* r
     Reading& reading = readings[index];
     if (!field)
     {
-      reading.Distance = std::numeric_limits<double>::quiet_NaN();
+      reading.Distance = reading.Clearance = std::numeric_limits<double>::quiet_NaN();
     }
     else
     {
       const bool near = field->GetDistance(centre) - tool->BoundingRadius <= snapshot.Silent;
       const std::vector<double>& points = near ? tool->Fine : tool->Coarse;
+      // The shield is nearer than the surface by at most the field's
+      // protrusion: a point whose surface distance exceeds the nearest
+      // clearance so far by more than that cannot lower it.
+      const double protrusion = field->GetMaximumProtrusion();
       double nearest = std::numeric_limits<double>::infinity();
+      double clearance = std::numeric_limits<double>::infinity();
       for (size_t n = 0; n < points.size(); n += 3)
       {
         const double* p = points.data() + n;
         const double ijk[3] = { toIJK[0] * p[0] + toIJK[1] * p[1] + toIJK[2] * p[2] + toIJK[3],
           toIJK[4] * p[0] + toIJK[5] * p[1] + toIJK[6] * p[2] + toIJK[7], toIJK[8] * p[0] + toIJK[9] * p[1] + toIJK[10] * p[2] + toIJK[11] };
-        nearest = std::min(nearest, field->GetDistance(ijk));
+        const double surface = field->GetDistance(ijk);
+        nearest = std::min(nearest, surface);
+        if (surface - protrusion < clearance)
+        {
+          double unused, shield;
+          field->GetDistances(ijk, unused, shield);
+          clearance = std::min(clearance, shield);
+        }
       }
-      reading.Distance = nearest;
+      reading.Clearance = clearance;
+      reading.Distance = clearance > 0.0 ? nearest : clearance;
     }
     reading.Level = snapshot.Level(reading.Distance);
     reading.FiringRate = snapshot.Rate(reading.Distance);
@@ -847,6 +884,12 @@ double vtkVolumeCutNerveMonitor::GetDistance(int index) const
                                                                          : std::numeric_limits<double>::quiet_NaN();
 }
 
+double vtkVolumeCutNerveMonitor::GetClearance(int index) const
+{
+  return index >= 0 && index < static_cast<int>(this->Readings.size()) ? this->Readings[index].Clearance
+                                                                         : std::numeric_limits<double>::quiet_NaN();
+}
+
 int vtkVolumeCutNerveMonitor::GetLevel(int index) const
 {
   return index >= 0 && index < static_cast<int>(this->Readings.size()) ? this->Readings[index].Level : NotReady;
@@ -878,6 +921,7 @@ void vtkVolumeCutNerveMonitor::PrintSelf(ostream& os, vtkIndent indent)
      << internal.Bursts << "\n";
   os << indent << "MaximumFiringRate: " << internal.MaximumRate << " /s\n";
   os << indent << "Range: " << this->Range << " mm\n";
+  os << indent << "ContactRange: " << this->ContactRange << " mm\n";
   os << indent << "Smoothing: " << this->Smoothing << " voxels\n";
   os << indent << "SampleSpacing: " << this->SampleSpacing << " mm\n";
   os << indent << "Structures: " << internal.Structures.size() << (this->IsBuilt() ? " (built)" : " (not all built)") << "\n";

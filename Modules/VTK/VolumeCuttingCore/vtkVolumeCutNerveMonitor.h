@@ -8,29 +8,38 @@
  * drill nears them, as facial-nerve EMG monitors make nerve irritation
  * audible in the operating room. Here each monitored structure (facial
  * nerve, chorda tympani, sigmoid sinus, ...) is a label in an integer image
- * on the anatomy's voxel grid, with a name. Its surface is where the cut
- * stops: the shield (vtkVolumeCutProtection) keeps the structure's smoothed
- * interior (the surface the renderer draws, vtkVolumeCutLabelSurface, closed
- * across the slices as the shield closes it) and every one of its voxels
- * whole, so the monitor reads contact when the burr touches either. Per
- * structure, Build computes a signed distance field (mm, negative inside)
- * to the union of the two, stored in sparse 8^3 bricks: the smoothed
- * surface's distance (foot points on its sub-voxel zero set, propagated to
- * every voxel within Range of it, vtkVolumeCutNerveMonitorField) read by
- * trilinear interpolation, and the voxel cubes' exactly (each sample keeps
- * its nearest cube; a query measures to the cubes of the eight samples
- * around it, where interpolation would overshoot their edges and corners).
+ * on the anatomy's voxel grid, with a name. Per structure, Build computes a
+ * sparse field (vtkVolumeCutNerveMonitorField, 8^3 bricks within Range) of
+ * two signed distances (mm, negative inside):
  *
- * A reading, per structure: the distance (mm) from the tool's surface to
- * the structure's surface (exact for the spherical burr: the field at the
- * centre minus the radius; for any vtkVolumeCutTool the least field value
- * over points on the tool's surface, SampleSpacing apart), the level it
- * falls in (thresholds in mm, defaults 4, 2 and 1: silent above 4, sparse
- * clicks from 2 to 4, bursts from 1 to 2, continuous below 1, contact at 0
- * or less) and a firing rate (spikes/s) that rises with proximity:
- * MaximumFiringRate * (1 - distance / silent threshold)^2, the maximum at
- * contact. Beyond Range the field is not stored: the distance is then a
- * lower bound (at least Range), and the level silent.
+ * - to the structure's smoothed surface (the surface the renderer draws,
+ *   vtkVolumeCutLabelSurface, closed across the slices as the shield closes
+ *   it): foot points on its sub-voxel zero set, propagated to every voxel,
+ *   read by trilinear interpolation. This is the reading, the anatomy's
+ *   distance.
+ * - to what the shield keeps (vtkVolumeCutProtection keeps the smoothed
+ *   interior and every one of the structure's voxels whole), where the cut
+ *   stops: the smaller of the smoothed surface's distance and the voxel
+ *   cubes', exact (each sample near the cubes keeps its nearest cube; a
+ *   query measures to the cubes of the eight samples around it). This is the
+ *   clearance. It is exact wherever the cubes are within ContactRange; beyond,
+ *   it is the surface distance.
+ *
+ * A reading, per structure: the clearance, from the tool's surface to what
+ * the shield keeps, and the distance from the tool's surface to the
+ * structure's smoothed surface while the clearance is positive, the
+ * clearance (0 or less) once the tool touches the shield: on coarse slices
+ * the cubes stand up to a millimetre out of the smoothed surface and stop
+ * the burr there, and the reading then says contact, never "1 mm away".
+ * Exact for the spherical burr (the fields at the centre minus the radius);
+ * for any vtkVolumeCutTool the least field values over points on the tool's
+ * surface, SampleSpacing apart. The level the distance falls in (thresholds
+ * in mm, defaults 4, 2 and 1: silent above 4, sparse clicks from 2 to 4,
+ * bursts from 1 to 2, continuous below 1, contact at 0 or less) and a firing
+ * rate (spikes/s) that rises with proximity: MaximumFiringRate * (1 -
+ * distance / silent threshold)^2, the maximum at contact. Beyond Range the
+ * field is not stored: the distance is then a lower bound (at least Range),
+ * and the level silent.
  *
  * Threads. Configuration (geometry, structures, thresholds) belongs to one
  * thread. Build may run on a worker while any thread measures: the fields
@@ -92,7 +101,10 @@ public:
   /// One structure's reading.
   struct VTK_WRAPEXCLUDE Reading
   {
+    /// To the smoothed surface while Clearance > 0, else Clearance.
     double Distance = 0.0;
+    /// To what the shield keeps (the smoothed interior and the voxel cubes).
+    double Clearance = 0.0;
     double FiringRate = 0.0;
     int Level = NotReady;
   };
@@ -162,6 +174,17 @@ public:
 
   ///@{
   /**
+   * Set/get how far from a structure's voxel cubes the clearance is exact
+   * (mm, at most Range): contact is exact for burrs of a smaller radius. The
+   * band of the cubes' distances costs build time and memory. Default 4 (an
+   * 8 mm burr). Takes effect for fields built afterwards.
+   */
+  vtkSetClampMacro(ContactRange, double, 0.5, 100.0);
+  vtkGetMacro(ContactRange, double);
+  ///@}
+
+  ///@{
+  /**
    * Set/get the in-slice Gaussian (voxels) that smooths the structures'
    * surfaces, as the renderer's LabelSmoothing and the shield's
    * SurfaceSmoothing; 0: the voxel cubes alone, as the shield then is.
@@ -186,11 +209,13 @@ public:
   double GetFiringRateOfDistance(double distance) const;
 
   /**
-   * Signed distance (mm) from a RAS point to a structure's surface (negative
-   * inside); a lower bound beyond Range; NaN before its field is built or
-   * for an unknown index.
+   * Signed distance (mm) from a RAS point to a structure's smoothed surface
+   * (negative inside); a lower bound beyond Range; NaN before its field is
+   * built or for an unknown index.
    */
   double GetDistanceAt(int index, const double ras[3]) const;
+  /// As GetDistanceAt, to what the shield keeps (the smoothed interior and the voxel cubes).
+  double GetClearanceAt(int index, const double ras[3]) const;
 
   /**
    * Any thread, never waits, allocates nothing: readings for the spherical
@@ -236,6 +261,7 @@ public:
   ///@{
   /// The current readings of structure index (NaN, 0 and NotReady before any).
   double GetDistance(int index) const;
+  double GetClearance(int index) const;
   int GetLevel(int index) const;
   double GetFiringRate(int index) const;
   /// The highest level over the structures (NotReady if none is ready).
@@ -250,7 +276,11 @@ protected:
 
   struct Internals;
   std::unique_ptr<Internals> Internal;
+  /// Both distances of structure index at a RAS point; false before its field is built or for an unknown index.
+  bool GetDistancesAt(int index, const double ras[3], double& surface, double& shield) const;
+
   double Range = 8.0;
+  double ContactRange = 4.0;
   double Smoothing = 1.0;
   double SampleSpacing = 0.2;
   double LastBuildTime = 0.0;

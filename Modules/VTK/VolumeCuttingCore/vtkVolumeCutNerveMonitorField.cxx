@@ -236,6 +236,66 @@ void CubeDistances(const uint16_t* mask, const int dims[3], const double spacing
   }
 }
 
+/// The cube distances of CubeDistances over a box of the mask only (the
+/// rest of the mask reads as beyond it): the transform costs what the box holds.
+struct BoxedCubeDistances
+{
+  int Box[6];
+  int Dims[3];
+  int MaskDims[3];
+  std::vector<float> Squared;
+  std::vector<int32_t> Nearest;
+
+  void Compute(const uint16_t* mask, const int maskDims[3], const int box[6], const double spacing[3], bool of)
+  {
+    std::copy(box, box + 6, this->Box);
+    std::copy(maskDims, maskDims + 3, this->MaskDims);
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      this->Dims[axis] = box[2 * axis + 1] - box[2 * axis] + 1;
+    }
+    std::vector<uint16_t> boxMask(static_cast<size_t>(this->Dims[0]) * this->Dims[1] * this->Dims[2]);
+    for (int k = 0; k < this->Dims[2]; ++k)
+    {
+      for (int j = 0; j < this->Dims[1]; ++j)
+      {
+        const uint16_t* row = mask + box[0] + static_cast<size_t>(maskDims[0]) * ((box[2] + j) + static_cast<size_t>(maskDims[1]) * (box[4] + k));
+        std::copy(row, row + this->Dims[0], boxMask.begin() + static_cast<size_t>(this->Dims[0]) * (j + static_cast<size_t>(this->Dims[1]) * k));
+      }
+    }
+    CubeDistances(boxMask.data(), this->Dims, spacing, of, this->Squared, this->Nearest);
+  }
+  /// Index in the box of a mask voxel, -1 outside it.
+  vtkIdType Local(int i, int j, int k) const
+  {
+    if (i < this->Box[0] || i > this->Box[1] || j < this->Box[2] || j > this->Box[3] || k < this->Box[4] || k > this->Box[5])
+    {
+      return -1;
+    }
+    return (i - this->Box[0]) + static_cast<vtkIdType>(this->Dims[0]) * ((j - this->Box[2]) + static_cast<vtkIdType>(this->Dims[1]) * (k - this->Box[4]));
+  }
+  /// Distance (mm) from a voxel centre to the nearest cube; infinite outside the box.
+  double DistanceAt(int i, int j, int k) const
+  {
+    const vtkIdType local = this->Local(i, j, k);
+    return local < 0 ? std::numeric_limits<double>::infinity() : std::sqrt(static_cast<double>(this->Squared[local]));
+  }
+  /// The nearest cube's voxel as a mask index (-1: none, or outside the box).
+  int32_t NearestAt(int i, int j, int k) const
+  {
+    const vtkIdType local = this->Local(i, j, k);
+    const int32_t nearest = local < 0 ? -1 : this->Nearest[local];
+    if (nearest < 0)
+    {
+      return -1;
+    }
+    const int li = nearest % this->Dims[0];
+    const int lj = (nearest / this->Dims[0]) % this->Dims[1];
+    const int lk = nearest / (this->Dims[0] * this->Dims[1]);
+    return static_cast<int32_t>((li + this->Box[0]) + static_cast<vtkIdType>(this->MaskDims[0]) * ((lj + this->Box[2]) + static_cast<vtkIdType>(this->MaskDims[1]) * (lk + this->Box[4])));
+  }
+};
+
 /// A sample's nearest cube, packed as its offset from the sample (10 bits
 /// per axis, within +-511 voxels: the stored band never reaches farther)
 /// and which side it is on: no division when a query unpacks it.
@@ -262,20 +322,20 @@ int32_t PackCubeReference(int32_t cube, int i, int j, int k, const int dims[3], 
 /// Surface points, and for every voxel the index of the nearest one found so far.
 struct FootPoints
 {
-  std::vector<float> X, Y, Z;
+  /// x, y, z of each point together: the sweeps read them at random, one cache line a point.
+  std::vector<float> Points;
   std::vector<int32_t> Nearest;
   std::vector<float> SquaredDistance;
 
   int32_t Add(const double p[3])
   {
-    this->X.push_back(static_cast<float>(p[0]));
-    this->Y.push_back(static_cast<float>(p[1]));
-    this->Z.push_back(static_cast<float>(p[2]));
-    return static_cast<int32_t>(this->X.size() - 1);
+    this->Points.insert(this->Points.end(), { static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]) });
+    return static_cast<int32_t>(this->Points.size() / 3 - 1);
   }
   double SquaredDistanceTo(int32_t foot, const double p[3]) const
   {
-    const double dx = p[0] - this->X[foot], dy = p[1] - this->Y[foot], dz = p[2] - this->Z[foot];
+    const float* point = this->Points.data() + 3 * static_cast<size_t>(foot);
+    const double dx = p[0] - point[0], dy = p[1] - point[1], dz = p[2] - point[2];
     return dx * dx + dy * dy + dz * dz;
   }
   void Offer(vtkIdType voxel, int32_t foot, const double p[3])
@@ -363,7 +423,7 @@ void Sweep(const LevelGrid& grid, FootPoints& feet, bool forward)
 
 //------------------------------------------------------------------------------
 std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorField::Build(const uint16_t* mask, const int dims[3],
-  const int origin[3], const double spacing[3], const int labelBox[6], double smoothing, double range)
+  const int origin[3], const double spacing[3], const int labelBox[6], double smoothing, double range, double contactRange)
 {
   vtkVolumeCutLabelSurface::Levels levels;
   if (!vtkVolumeCutLabelSurface::Initialize(dims, spacing, labelBox, smoothing, levels))
@@ -400,49 +460,31 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   }
   // The shield also keeps every voxel of the structure whole: the protected
   // region is the smoothed interior and the voxel cubes together, whose
-  // distance outside is the smaller of the two distances.
-  std::vector<float> outsideCubes, insideCubes;
-  std::vector<int32_t> nearestCube, nearestFree;
-  CubeDistances(mask, dims, spacing, true, outsideCubes, nearestCube);
-  // Inside, the nearest free voxel is within the structure's box grown by
-  // one voxel: the transform of the free cubes needs no more than that.
+  // distance outside is the smaller of the two distances. Contact needs the
+  // cubes' distance within contactRange of them (a burr's radius): the
+  // transform of the structure's cubes runs over the label's box grown by
+  // that and a brick's diagonal (a brick kept for the cubes has a sample
+  // within contactRange and a cell's diagonal of them); without smoothing
+  // the cubes are the surface too, wanted across the whole band.
+  const bool useSmoothed = smoothing > 0.0;
+  const double cellDiagonal = std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
+  const double cubeBand = useSmoothed ? std::min(contactRange, range) + cellDiagonal : std::numeric_limits<double>::infinity();
+  int cubeBox[6];
   int freeBox[6];
-  int freeDims[3];
   for (int axis = 0; axis < 3; ++axis)
   {
+    const double reach = cubeBand + BrickCells * cellDiagonal;
+    const int grow = std::isfinite(reach) ? static_cast<int>(std::ceil(reach / spacing[axis])) + 1 : dims[axis];
+    cubeBox[2 * axis] = std::max(0, labelBox[2 * axis] - grow);
+    cubeBox[2 * axis + 1] = std::min(dims[axis] - 1, labelBox[2 * axis + 1] + grow);
+    // Inside, the nearest free voxel is within the structure's box grown by one voxel.
     freeBox[2 * axis] = std::max(0, labelBox[2 * axis] - 1);
     freeBox[2 * axis + 1] = std::min(dims[axis] - 1, labelBox[2 * axis + 1] + 1);
-    freeDims[axis] = freeBox[2 * axis + 1] - freeBox[2 * axis] + 1;
   }
-  {
-    std::vector<uint16_t> boxMask(static_cast<size_t>(freeDims[0]) * freeDims[1] * freeDims[2]);
-    for (int k = 0; k < freeDims[2]; ++k)
-    {
-      for (int j = 0; j < freeDims[1]; ++j)
-      {
-        const uint16_t* row = mask + grid.Index(freeBox[0], freeBox[2] + j, freeBox[4] + k);
-        std::copy(row, row + freeDims[0], boxMask.begin() + static_cast<size_t>(freeDims[0]) * (j + static_cast<size_t>(freeDims[1]) * k));
-      }
-    }
-    CubeDistances(boxMask.data(), freeDims, spacing, false, insideCubes, nearestFree);
-  }
-  // The free voxel nearest to a structure's voxel, as a mask index (-1 if none).
-  auto freeIndex = [&](int i, int j, int k) -> vtkIdType {
-    return (i - freeBox[0]) + static_cast<vtkIdType>(freeDims[0]) * ((j - freeBox[2]) + static_cast<vtkIdType>(freeDims[1]) * (k - freeBox[4]));
-  };
-  auto nearestFreeVoxel = [&](int i, int j, int k) -> int32_t {
-    const int32_t local = nearestFree[freeIndex(i, j, k)];
-    if (local < 0)
-    {
-      return -1;
-    }
-    const int li = local % freeDims[0];
-    const int lj = (local / freeDims[0]) % freeDims[1];
-    const int lk = local / (freeDims[0] * freeDims[1]);
-    return static_cast<int32_t>(grid.Index(li + freeBox[0], lj + freeBox[2], lk + freeBox[4]));
-  };
+  BoxedCubeDistances outsideCubes, insideCubes;
+  outsideCubes.Compute(mask, dims, cubeBox, spacing, true);
+  insideCubes.Compute(mask, dims, freeBox, spacing, false);
   const vtkIdType strides[3] = { 1, dims[0], static_cast<vtkIdType>(dims[0]) * dims[1] };
-  const bool useSmoothed = smoothing > 0.0;
   auto labelled = [&](vtkIdType voxel) { return mask[voxel] != 0; };
   FootPoints feet;
   feet.Nearest.assign(count, -1);
@@ -534,7 +576,8 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   std::copy(dims, dims + 3, field->Dimensions);
   std::copy(spacing, spacing + 3, field->Spacing);
   field->Range = range;
-  field->NumberOfFootPoints = feet.X.size();
+  field->SurfaceIsCubes = !useSmoothed;
+  field->NumberOfFootPoints = feet.Points.size() / 3;
   for (int axis = 0; axis < 3; ++axis)
   {
     // The smoothed surface may reach a voxel beyond the structure's voxels.
@@ -547,6 +590,7 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
   constexpr int samplesPerBrick = BrickSamples * BrickSamples * BrickSamples;
   std::vector<float> samples(samplesPerBrick);
   std::vector<int32_t> sampleCubes(samplesPerBrick);
+  double protrusion = 0.0;
   for (int bz = 0; bz < field->BrickCounts[2]; ++bz)
   {
     for (int by = 0; by < field->BrickCounts[1]; ++by)
@@ -554,6 +598,8 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
       for (int bx = 0; bx < field->BrickCounts[0]; ++bx)
       {
         double nearest = std::numeric_limits<double>::infinity();
+        double nearestCubes = std::numeric_limits<double>::infinity();
+        double brickProtrusion = 0.0;
         bool inside = false;
         int n = 0;
         for (int z = 0; z < BrickSamples; ++z)
@@ -566,19 +612,21 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
             {
               const int i = std::min(bx * BrickCells + x, dims[0] - 1);
               const vtkIdType voxel = grid.Index(i, j, k);
-              const double cubes = labelled(voxel) ? -std::sqrt(static_cast<double>(insideCubes[freeIndex(i, j, k)]))
-                                                   : std::sqrt(static_cast<double>(outsideCubes[voxel]));
+              const double cubes = labelled(voxel) ? -insideCubes.DistanceAt(i, j, k) : outsideCubes.DistanceAt(i, j, k);
               const double smoothed = std::sqrt(static_cast<double>(feet.SquaredDistance[voxel]));
               const double smoothedSigned = grid.Values[voxel] <= 0.f ? -smoothed : smoothed;
-              const double value = useSmoothed ? std::min(cubes, smoothedSigned) : cubes;
+              const double surface = useSmoothed ? smoothedSigned : cubes;
+              const double shield = std::min(cubes, surface);
               // The smoothed surface's distance is interpolated; the cubes'
               // is computed exactly at query time from the nearest cube of
               // the structure (outside it) or of the free voxels (inside).
               samples[n] = static_cast<float>(useSmoothed ? smoothedSigned : NoSmoothedSurface);
-              const int32_t cube = labelled(voxel) ? nearestFreeVoxel(i, j, k) : nearestCube[voxel];
+              const int32_t cube = labelled(voxel) ? insideCubes.NearestAt(i, j, k) : outsideCubes.NearestAt(i, j, k);
               sampleCubes[n] = cube < 0 ? -1 : PackCubeReference(cube, i, j, k, dims, labelled(voxel));
-              nearest = std::min(nearest, std::abs(value));
-              inside = inside || value < 0.0;
+              nearest = std::min(nearest, std::abs(shield));
+              nearestCubes = std::min(nearestCubes, std::abs(cubes));
+              brickProtrusion = std::max(brickProtrusion, surface - shield);
+              inside = inside || shield < 0.0;
             }
           }
         }
@@ -587,7 +635,13 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
         {
           field->Directory[brick] = static_cast<int32_t>(field->Bricks.size() / samplesPerBrick);
           field->Bricks.insert(field->Bricks.end(), samples.begin(), samples.end());
-          field->NearestCubes.insert(field->NearestCubes.end(), sampleCubes.begin(), sampleCubes.end());
+          const bool keepCubes = nearestCubes <= cubeBand;
+          field->CubeDirectory.push_back(keepCubes ? static_cast<int32_t>(field->NearestCubes.size() / samplesPerBrick) : -1);
+          if (keepCubes)
+          {
+            field->NearestCubes.insert(field->NearestCubes.end(), sampleCubes.begin(), sampleCubes.end());
+            protrusion = std::max(protrusion, brickProtrusion);
+          }
         }
         else
         {
@@ -596,7 +650,11 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
       }
     }
   }
+  // Between samples the interpolated surface distance and the exact cubes'
+  // may part by up to a cell's diagonal more than at the samples.
+  field->MaximumProtrusion = protrusion + cellDiagonal;
   field->Bricks.shrink_to_fit();
+  field->CubeDirectory.shrink_to_fit();
   field->NearestCubes.shrink_to_fit();
   return field;
 }
@@ -604,16 +662,58 @@ std::unique_ptr<const vtkVolumeCutNerveMonitorField> vtkVolumeCutNerveMonitorFie
 //------------------------------------------------------------------------------
 double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
 {
+  double surface, shield;
+  if (this->SurfaceIsCubes)
+  {
+    this->GetDistances(ijk, surface, shield);
+    return surface;
+  }
   double local[3];
   int brick[3];
   int cell[3];
   double t[3];
+  const float* s = this->Locate(ijk, local, brick, cell, t, surface);
+  return s ? this->Interpolate(s, t) : surface;
+}
+
+//------------------------------------------------------------------------------
+void vtkVolumeCutNerveMonitorField::GetDistances(const double ijk[3], double& surface, double& shield) const
+{
+  double local[3];
+  int brick[3];
+  int cell[3];
+  double t[3];
+  const float* s = this->Locate(ijk, local, brick, cell, t, surface);
+  if (!s)
+  {
+    shield = surface;
+    return;
+  }
+  const size_t stored = static_cast<size_t>(s - this->Bricks.data()) / (BrickSamples * BrickSamples * BrickSamples);
+  const int32_t cubes = this->CubeDirectory[stored];
+  const double smoothed = this->SurfaceIsCubes ? static_cast<double>(NoSmoothedSurface) : this->Interpolate(s, t);
+  if (cubes < 0)
+  {
+    // No cube within ContactRange of this brick: the shield is the smoothed surface here, or both are farther.
+    surface = shield = smoothed;
+    return;
+  }
+  const size_t inBrick = static_cast<size_t>(s - this->Bricks.data()) - stored * BrickSamples * BrickSamples * BrickSamples;
+  shield = this->GetShieldDistance(this->NearestCubes.data() + static_cast<size_t>(cubes) * BrickSamples * BrickSamples * BrickSamples + inBrick,
+    brick, cell, local, t, smoothed);
+  surface = this->SurfaceIsCubes ? shield : smoothed;
+}
+
+//------------------------------------------------------------------------------
+const float* vtkVolumeCutNerveMonitorField::Locate(const double ijk[3], double local[3], int brick[3], int cell[3], double t[3], double& outside) const
+{
   for (int axis = 0; axis < 3; ++axis)
   {
     local[axis] = ijk[axis] - this->Origin[axis];
     if (!(local[axis] >= 0.0 && local[axis] <= this->Dimensions[axis] - 1)) // NaN too
     {
-      return this->GetFarDistance(ijk);
+      outside = this->GetFarDistance(ijk);
+      return nullptr;
     }
     brick[axis] = std::min(static_cast<int>(local[axis]) / BrickCells, this->BrickCounts[axis] - 1);
     const double inBrick = local[axis] - brick[axis] * BrickCells;
@@ -623,10 +723,16 @@ double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
   const int32_t index = this->Directory[brick[0] + static_cast<size_t>(this->BrickCounts[0]) * (brick[1] + static_cast<size_t>(this->BrickCounts[1]) * brick[2])];
   if (index < 0)
   {
-    return index == DeepInside ? -this->Range : this->GetFarDistance(ijk);
+    outside = index == DeepInside ? -this->Range : this->GetFarDistance(ijk);
+    return nullptr;
   }
-  const float* s = this->Bricks.data() + static_cast<size_t>(index) * BrickSamples * BrickSamples * BrickSamples +
-    cell[0] + BrickSamples * (cell[1] + BrickSamples * cell[2]);
+  return this->Bricks.data() + static_cast<size_t>(index) * BrickSamples * BrickSamples * BrickSamples + cell[0] +
+    BrickSamples * (cell[1] + BrickSamples * cell[2]);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutNerveMonitorField::Interpolate(const float* s, const double t[3])
+{
   constexpr int sy = BrickSamples;
   constexpr int sz = BrickSamples * BrickSamples;
   const double x00 = s[0] + t[0] * (s[1] - s[0]);
@@ -635,14 +741,21 @@ double vtkVolumeCutNerveMonitorField::GetDistance(const double ijk[3]) const
   const double x11 = s[sz + sy] + t[0] * (s[sz + sy + 1] - s[sz + sy]);
   const double y0 = x00 + t[1] * (x10 - x00);
   const double y1 = x01 + t[1] * (x11 - x01);
-  const double smoothed = y0 + t[2] * (y1 - y0);
+  return y0 + t[2] * (y1 - y0);
+}
+
+//------------------------------------------------------------------------------
+double vtkVolumeCutNerveMonitorField::GetShieldDistance(const int32_t* nearest, const int brick[3], const int cell[3], const double local[3],
+  const double t[3], double smoothed) const
+{
+  constexpr int sy = BrickSamples;
+  constexpr int sz = BrickSamples * BrickSamples;
   // The voxel cubes' distance bends at their edges and corners, which
   // interpolation would miss: it is computed exactly to the cubes nearest
   // to the cell's corners. Outside the cubes (the voxel holding the point,
   // the nearest corner, is free): the distance to the structure's cubes
   // nearest to the free corners; inside: minus the distance to the free
   // cubes nearest to the structure's corners.
-  const int32_t* nearest = this->NearestCubes.data() + (s - this->Bricks.data());
   const int ownCorner = (t[0] >= 0.5 ? 1 : 0) + (t[1] >= 0.5 ? sy : 0) + (t[2] >= 0.5 ? sz : 0);
   const int32_t insideFlag = nearest[ownCorner] & 1;
   double squared = std::numeric_limits<double>::infinity();
@@ -700,5 +813,5 @@ double vtkVolumeCutNerveMonitorField::GetFarDistance(const double ijk[3]) const
 size_t vtkVolumeCutNerveMonitorField::GetMemorySize() const
 {
   return sizeof(*this) + this->Directory.capacity() * sizeof(int32_t) + this->Bricks.capacity() * sizeof(float) +
-    this->NearestCubes.capacity() * sizeof(int32_t);
+    this->CubeDirectory.capacity() * sizeof(int32_t) + this->NearestCubes.capacity() * sizeof(int32_t);
 }

@@ -1,18 +1,20 @@
 """The virtual nerve monitor's figures (issue 25), for the area ``feedback``.
 
-Accuracy: the monitor reads the distance to what the cut protects, the
-structure's smoothed interior together with its voxel cubes (the shield
-keeps every voxel of a protected structure whole). (1) An analytic nerve, a
-cylinder of 0.7 mm radius along an oblique axis, rasterised at 0.15 mm (the
-temporal-bone scale); burrs of 0.5, 1 and 2 mm radius at 0.05 to 3.5 mm from
-its surface around its middle: the monitor's distance against the exact one
-to the cylinder (the voxel stairs included: up to half a voxel's diagonal)
-and, baseline, the distance to the label's voxel cubes, measured on the same
-burrs in the same process. (2) Clinical voxels: a ball of 3 mm radius on
-1 x 1 x 1.5 mm voxels with the grid's direction flipped, monitored without
-smoothing (the shield is then the voxel cubes, known exactly): burrs placed
-0 to 2 mm from the cubes, the reading against that distance, and how often
-the level says contact wrongly a hair (0.02 mm) either side of touching.
+Accuracy: the monitor's reading is the distance to the structure's smoothed
+surface while the tool is clear of what the shield keeps (the smoothed
+interior and every voxel of the structure), and contact once it touches
+that. (1) An analytic nerve, a cylinder of 0.7 mm radius along an oblique
+axis, rasterised at 0.15 mm (the temporal-bone scale); burrs of 0.5, 1 and
+2 mm radius at 0.05 to 3.5 mm from its surface around its middle: the
+smoothed surface's distance (``GetDistanceAt`` less the radius) against the
+exact one to the cylinder and, baseline, the distance to the label's voxel
+cubes (what the reading was when it measured to the shield), measured on the
+same burrs in the same process. (2) Clinical voxels: a ball of 3 mm radius
+on 1 x 1 x 1.5 mm voxels with the grid's direction flipped, monitored
+without smoothing (the shield is then the voxel cubes, known exactly): burrs
+placed 0 to 2 mm from the cubes, the reading against that distance, and how
+often the level says contact wrongly a hair (0.02 mm) either side of
+touching.
 
 Cost: the temporal-bone case (``data.temporalbone``: 288^3 voxels of
 0.15 mm, 14 structures drawn slice by slice), 10 of its structures
@@ -106,14 +108,13 @@ def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
         radii.append(burr)
     measured = []
     for point, burr in zip(centres, radii):
-        monitor.UpdateWithBurr([float(v) for v in point], burr)
-        measured.append(monitor.GetDistance(0))
+        measured.append(monitor.GetDistanceAt(0, [float(v) for v in point]) - burr)
     error = np.abs(np.array(measured) - np.array(exact))
     voxel_centres = np.argwhere(labels[:, :, :] > 0)[:, ::-1] * CYLINDER_SPACING
     stairs = _voxel_cube_distance(np.array(centres), voxel_centres, CYLINDER_SPACING / 2) - np.array(radii)
     stairs_error = np.abs(stairs - np.array(exact))
     where = (f"cylinder nerve r {CYLINDER_RADIUS} mm at {CYLINDER_SPACING} mm voxels, {count} burrs of 0.5-2 mm at 0.05-3.5 mm; "
-             "against the analytic cylinder, voxel stairs included")
+             "the distance to the smoothed surface against the analytic cylinder")
     return [
         measurement(f"nerve monitor distance error, max ({where})", float(error.max()), "mm",
                     "distance to the label's voxel cubes, max error", float(stairs_error.max()), count, machine),

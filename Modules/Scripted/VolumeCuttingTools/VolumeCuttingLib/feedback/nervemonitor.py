@@ -56,16 +56,21 @@ def set_thresholds(monitor, silent: float, sparse: float, bursts: float) -> None
 
 
 def readings(monitor) -> dict:
-    """The monitor's current readings: ``{structure name: {distance_mm, level, firing_rate_hz}}``.
+    """The monitor's current readings: ``{structure name: {distance_mm, clearance_mm, level, firing_rate_hz}}``.
 
-    ``distance_mm`` is ``None`` while the structure's field is being built
-    (level ``"not ready"``).
+    ``distance_mm`` is the distance to the structure's smoothed surface while
+    the tool is clear of what the shield keeps, the clearance (0 or less,
+    level ``"contact"``) once it touches it; ``clearance_mm`` the distance to
+    what the shield keeps (the smoothed interior and the voxel cubes). Both
+    are ``None`` while the structure's field is being built (level ``"not ready"``).
     """
     result = {}
     for index in range(monitor.GetNumberOfStructures()):
         distance = monitor.GetDistance(index)
+        clearance = monitor.GetClearance(index)
         result[monitor.GetStructureName(index)] = {
             "distance_mm": None if math.isnan(distance) else round(float(distance), 4),
+            "clearance_mm": None if math.isnan(clearance) else round(float(clearance), 4),
             "level": level_name(monitor.GetLevel(index)),
             "firing_rate_hz": round(float(monitor.GetFiringRate(index)), 2),
         }

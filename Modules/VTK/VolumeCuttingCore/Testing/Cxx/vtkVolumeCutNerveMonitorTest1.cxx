@@ -185,61 +185,82 @@ void RandomDirection(vtkMinimalStandardRandomSequence* random, double direction[
   vtkMath::Normalize(direction);
 }
 
-/// Largest error of the burr's distance against the cylinder over burrs at
-/// several distances and radii around its middle (away from the grid's ends).
-double CylinderError(const double spacing[3], double turnDegrees, double radius, int positions, double& worstAt)
+/// Largest errors against the cylinder, over burrs at several distances and
+/// radii around its middle (away from the grid's ends): of the distance to
+/// the smoothed surface (the field at the centre less the radius), and of
+/// the reading where the burr is clear of the shield (where it touches the
+/// voxel cubes standing out of the surface, the reading is contact).
+struct CylinderErrors
 {
-  const double extent = 18.0; // mm
+  double Surface = 1e9;
+  double Reading = 1e9;
+  double WorstAt = 0.0;
+  int Clear = 0;
+};
+
+CylinderErrors CylinderError(const double spacing[3], double turnDegrees, const double axis[3], double radius, int positions)
+{
+  const double extent = 9.0; // mm: burr centres stay within 4 mm of the axis
   const int dims[3] = { int(extent / spacing[0]), int(extent / spacing[1]), int(extent / spacing[2]) };
   Grid grid(dims, spacing, turnDegrees);
   Cylinder nerve;
   grid.Centre(nerve.Point);
-  nerve.Axis[0] = 0.7;
-  nerve.Axis[1] = -0.4;
-  nerve.Axis[2] = 0.59;
+  std::copy(axis, axis + 3, nerve.Axis);
   vtkMath::Normalize(nerve.Axis);
   nerve.Radius = radius;
   auto labels = grid.Rasterise([&](const double* p) { return nerve.SurfaceDistance(p) <= 0.0; }, 7);
   vtkNew<vtkVolumeCutNerveMonitor> monitor;
   monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
+  monitor->SetRange(3.5); // every burr below is nearer: a smaller band to build
+  monitor->SetContactRange(1.5);
+  CylinderErrors errors;
   if (monitor->AddStructure("facial nerve", labels, 7) != 0 || monitor->Build() != 1)
   {
-    return 1e9;
+    return errors;
   }
+  errors.Surface = errors.Reading = 0.0;
   vtkNew<vtkMinimalStandardRandomSequence> random;
   random->SetSeed(25);
-  const double distances[] = { 0.05, 0.3, 1.0, 1.5, 2.5, 3.5 };
-  const double burrRadii[] = { 0.5, 1.0, 2.0 };
-  double worst = 0.0;
+  const double distances[] = { 0.05, 0.3, 1.0, 2.0 };
+  const double burrRadii[] = { 0.5, 1.0 };
   for (int n = 0; n < positions; ++n)
   {
-    const double distance = distances[n % 6];
-    const double burr = burrRadii[(n / 6) % 3];
+    const double distance = distances[n % 4];
+    const double burr = burrRadii[(n / 4) % 2];
     // A point on the axis within 2 mm of the middle, then out along a random normal.
     double normal[3];
     RandomDirection(random, normal);
     const double along = vtkMath::Dot(normal, nerve.Axis);
-    for (int axis = 0; axis < 3; ++axis)
+    for (int a = 0; a < 3; ++a)
     {
-      normal[axis] -= along * nerve.Axis[axis];
+      normal[a] -= along * nerve.Axis[a];
     }
     vtkMath::Normalize(normal);
     const double s = Random(random, -2.0, 2.0);
     double centre[3];
-    for (int axis = 0; axis < 3; ++axis)
+    for (int a = 0; a < 3; ++a)
     {
-      centre[axis] = nerve.Point[axis] + s * nerve.Axis[axis] + (radius + burr + distance) * normal[axis];
+      centre[a] = nerve.Point[a] + s * nerve.Axis[a] + (radius + burr + distance) * normal[a];
+    }
+    const double surfaceError = std::abs(monitor->GetDistanceAt(0, centre) - burr - distance);
+    if (surfaceError > errors.Surface)
+    {
+      errors.Surface = surfaceError;
+      errors.WorstAt = distance;
     }
     Reading reading;
     monitor->Measure(centre, burr, &reading, 1);
-    const double error = std::abs(reading.Distance - distance);
-    if (error > worst)
+    if (reading.Clearance > 0.0)
     {
-      worst = error;
-      worstAt = distance;
+      ++errors.Clear;
+      errors.Reading = std::max(errors.Reading, std::abs(reading.Distance - distance));
+    }
+    else if (reading.Level != vtkVolumeCutNerveMonitor::Contact || reading.Distance != reading.Clearance)
+    {
+      errors.Reading = 1e9; // touching the shield reads contact, the clearance
     }
   }
-  return worst;
+  return errors;
 }
 
 int TestCylinderAccuracy()
@@ -248,22 +269,30 @@ int TestCylinderAccuracy()
   {
     double Spacing[3];
     double Turn;
+    double Axis[3];
     double Radius;
   };
-  // The monitor reads the shield the cut respects, which keeps the nerve's
-  // voxel cubes whole: against the analytic cylinder its reading departs by
-  // up to the cubes' stairs, half a voxel's diagonal (0.13 mm at 0.15 mm
-  // voxels); vtkVolumeCutNerveMonitorTest2 checks it against the shield.
-  const Case cases[] = { { { 0.15, 0.15, 0.15 }, 0.0, 0.8 }, { { 0.15, 0.15, 0.15 }, 33.0, 0.6 }, { { 0.12, 0.15, 0.25 }, 20.0, 1.0 },
-    { { 0.2, 0.2, 0.4 }, 0.0, 1.5 } };
+  // The bound for the reading, the distance to the smoothed
+  // surface: 0.05 mm from the analytic nerve, on temporal-bone voxels
+  // straight and turned. On anisotropic voxels the smoothed surface itself
+  // (vtkVolumeCutLabelSurface, shared with the renderer and the shield)
+  // departs further from the cylinder, where the nerve's top and bottom
+  // run nearly along the slices and their outlines are interpolated
+  // linearly across them: the bound is then 0.4 of the slice spacing (the
+  // field against that surface is checked to 0.02 mm below).
+  const Case cases[] = { { { 0.15, 0.15, 0.15 }, 0.0, { 0.7, -0.4, 0.59 }, 0.8 }, { { 0.15, 0.15, 0.15 }, 33.0, { 0.2, 0.9, -0.3 }, 0.6 },
+    { { 0.12, 0.15, 0.25 }, 20.0, { 0.7, -0.4, 0.59 }, 1.0 }, { { 0.2, 0.2, 0.3 }, 0.0, { 1.0, 0.1, 0.05 }, 1.2 } };
   for (const Case& c : cases)
   {
-    double worstAt = 0.0;
-    const double error = CylinderError(c.Spacing, c.Turn, c.Radius, 360, worstAt);
+    const CylinderErrors errors = CylinderError(c.Spacing, c.Turn, c.Axis, c.Radius, 64);
     std::cout << "cylinder radius " << c.Radius << " mm, spacing " << c.Spacing[0] << " x " << c.Spacing[1] << " x " << c.Spacing[2]
-              << " mm, grid turned " << c.Turn << " degrees: max error " << error << " mm (at " << worstAt << " mm)" << std::endl;
-    const double halfDiagonal = 0.5 * std::sqrt(c.Spacing[0] * c.Spacing[0] + c.Spacing[1] * c.Spacing[1] + c.Spacing[2] * c.Spacing[2]);
-    CHECK_BOOL(error <= halfDiagonal, true);
+              << " mm, grid turned " << c.Turn << " degrees: smoothed-surface distance max error " << errors.Surface << " mm (at "
+              << errors.WorstAt << " mm); reading " << errors.Reading << " mm over the " << errors.Clear << " burrs clear of the shield"
+              << std::endl;
+    const double bound = std::max(0.05, 0.4 * std::max({ c.Spacing[0], c.Spacing[1], c.Spacing[2] }));
+    CHECK_BOOL(errors.Surface <= bound, true);
+    CHECK_BOOL(errors.Reading <= bound, true);
+    CHECK_BOOL(errors.Clear >= 40, true);
   }
   return EXIT_SUCCESS;
 }
@@ -271,13 +300,15 @@ int TestCylinderAccuracy()
 int TestSphereAccuracyAndTools()
 {
   const double spacing[3] = { 0.15, 0.18, 0.22 };
-  const int dims[3] = { 130, 110, 90 }; // about 20 mm across: every burr below stays inside
+  const int dims[3] = { 82, 68, 56 }; // about 12 mm across: every burr below stays inside
   Grid grid(dims, spacing, 15.0);
   double centre[3];
   grid.Centre(centre);
   const double radius = 1.5;
   auto labels = grid.Rasterise([&](const double* p) { return std::sqrt(vtkMath::Distance2BetweenPoints(p, centre)) <= radius; }, 3);
   vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  monitor->SetRange(4.0);
+  monitor->SetContactRange(3.5); // the clearance exact for every burr and tool below
   CHECK_BOOL(monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS), true);
   CHECK_INT(monitor->AddStructure("vestibule", labels, 3), 0);
   // Before Build: not ready, never a guess.
@@ -285,54 +316,75 @@ int TestSphereAccuracyAndTools()
   CHECK_INT(monitor->Measure(centre, 1.0, &reading, 1), 1);
   CHECK_INT(reading.Level, vtkVolumeCutNerveMonitor::NotReady);
   CHECK_BOOL(std::isnan(reading.Distance), true);
+  CHECK_BOOL(std::isnan(reading.Clearance), true);
   CHECK_INT(monitor->Build(), 1);
   CHECK_BOOL(monitor->IsBuilt(), true);
 
+  // The reading against the analytic sphere: the smoothed surface's
+  // distance within 0.05 mm while the burr is clear of the shield; touching
+  // the voxel cubes that stand out of it, contact.
   vtkNew<vtkMinimalStandardRandomSequence> random;
   random->SetSeed(3);
   double worst = 0.0;
-  for (int n = 0; n < 400; ++n)
+  int clear = 0;
+  for (int n = 0; n < 200; ++n)
   {
     double direction[3];
     RandomDirection(random, direction);
-    const double distance = Random(random, 0.02, 3.5);
-    const double burr = Random(random, 0.5, 2.0);
+    const double distance = Random(random, 0.02, 2.5);
+    const double burr = Random(random, 0.5, 1.5);
     double p[3];
     for (int axis = 0; axis < 3; ++axis)
     {
       p[axis] = centre[axis] + (radius + burr + distance) * direction[axis];
     }
     monitor->Measure(p, burr, &reading, 1);
-    worst = std::max(worst, std::abs(reading.Distance - distance));
+    CHECK_BOOL(reading.Clearance <= reading.Distance, true);
+    worst = std::max(worst, std::abs(monitor->GetDistanceAt(0, p) - burr - distance));
+    if (reading.Clearance > 0.0)
+    {
+      ++clear;
+      worst = std::max(worst, std::abs(reading.Distance - distance));
+    }
+    else
+    {
+      CHECK_INT(reading.Level, vtkVolumeCutNerveMonitor::Contact);
+    }
   }
-  std::cout << "sphere radius 1.5 mm, spacing 0.15 x 0.18 x 0.22 mm: max error " << worst << " mm" << std::endl;
-  // The monitor reads the shield the cut respects: the smoothed interior and
-  // the sphere's voxel cubes together, and the cubes stand out of the sphere
-  // by up to half a voxel's diagonal (0.16 mm here). Against that region,
-  // found independently (the smoothed surface's points and the exact
-  // distance to the cubes), the field is far closer.
-  const double halfDiagonal = 0.5 * std::sqrt(spacing[0] * spacing[0] + spacing[1] * spacing[1] + spacing[2] * spacing[2]);
-  CHECK_BOOL(worst <= halfDiagonal, true);
-  const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 6);
+  std::cout << "sphere radius 1.5 mm, spacing 0.15 x 0.18 x 0.22 mm: max error " << worst << " mm (" << clear << " of 200 burrs clear of the shield)"
+            << std::endl;
+  CHECK_BOOL(worst <= 0.4 * spacing[2], true); // anisotropic: as for the cylinders
+  CHECK_BOOL(clear >= 150, true);
+  // Against the two surfaces found independently (the smoothed surface's
+  // points, the exact distance to the voxel cubes) the fields are far closer.
+  const std::vector<double> surface = SmoothedSurfacePoints(grid, labels, 3, monitor->GetSmoothing(), 3);
   const std::vector<int> voxels = vtkVolumeCutNerveMonitorTesting::VoxelsOf(labels, 3);
-  double worstOwn = 0.0;
-  for (int n = 0; n < 120; ++n)
+  double worstSurface = 0.0, worstShield = 0.0;
+  for (int n = 0; n < 60; ++n)
   {
     double direction[3];
     RandomDirection(random, direction);
-    const double burr = Random(random, 0.5, 2.0);
-    const double distance = Random(random, 0.0, 3.5);
+    const double distance = Random(random, 0.0, 2.5);
     double p[3];
     for (int axis = 0; axis < 3; ++axis)
     {
-      p[axis] = centre[axis] + (radius + burr + distance) * direction[axis];
+      p[axis] = centre[axis] + (radius + distance) * direction[axis];
     }
-    monitor->Measure(p, burr, &reading, 1);
-    const double shield = std::min(NearestDistance(surface, p), vtkVolumeCutNerveMonitorTesting::VoxelCubeDistance(grid.IJKToRAS, voxels, p));
-    worstOwn = std::max(worstOwn, std::abs(reading.Distance - (shield - burr)));
+    const double smoothed = NearestDistance(surface, p);
+    const double shield = std::min(smoothed, vtkVolumeCutNerveMonitorTesting::VoxelCubeDistance(grid.IJKToRAS, voxels, p));
+    worstSurface = std::max(worstSurface, std::abs(monitor->GetDistanceAt(0, p) - smoothed));
+    if (shield <= monitor->GetContactRange())
+    {
+      worstShield = std::max(worstShield, std::abs(monitor->GetClearanceAt(0, p) - shield));
+    }
   }
-  std::cout << "against the smoothed surface and the voxel cubes (" << surface.size() / 3 << " points): max error " << worstOwn << " mm" << std::endl;
-  CHECK_BOOL(worstOwn <= 0.02, true);
+  std::cout << "against the smoothed surface (" << surface.size() / 3 << " points): max error " << worstSurface
+            << " mm; the clearance against the shield (that surface and the voxel cubes): " << worstShield << " mm" << std::endl;
+  // The monitor's surface is closed across the slices as the shield's is
+  // (over the poles, which the levels found here leave open): that moves
+  // it there by a few hundredths of a millimetre.
+  CHECK_BOOL(worstSurface <= 0.05, true);
+  CHECK_BOOL(worstShield <= 0.02, true);
 
   // Any tool: a sphere given as an ellipsoid reads as the burr does; a
   // cylinder burr against its exact distance to the sphere.
@@ -341,12 +393,12 @@ int TestSphereAccuracyAndTools()
   vtkNew<vtkVolumeCutCylinderTool> cylinder;
   cylinder->SetRadius(0.8);
   cylinder->SetLength(4.0);
-  double worstBall = 0.0, worstCylinder = 0.0;
-  for (int n = 0; n < 60; ++n)
+  double worstBall = 0.0, worstBallClearance = 0.0, worstCylinder = 0.0;
+  for (int n = 0; n < 30; ++n)
   {
     double direction[3];
     RandomDirection(random, direction);
-    const double distance = Random(random, 0.1, 3.0);
+    const double distance = Random(random, 0.1, 2.0);
     vtkNew<vtkTransform> pose;
     pose->Translate(centre[0] + (radius + 1.2 + distance) * direction[0], centre[1] + (radius + 1.2 + distance) * direction[1],
       centre[2] + (radius + 1.2 + distance) * direction[2]);
@@ -354,7 +406,14 @@ int TestSphereAccuracyAndTools()
     CHECK_BOOL(monitor->UpdateWithTool(ball, pose->GetMatrix()), true);
     const double* position = pose->GetPosition();
     monitor->Measure(position, 1.2, &reading, 1);
-    worstBall = std::max(worstBall, std::abs(monitor->GetDistance(0) - reading.Distance));
+    // Touching, the two clearances are both negative but measured differently
+    // (the burr's depth at its centre, the tool's deepest surface point).
+    if (reading.Clearance > 0.0 && monitor->GetClearance(0) > 0.0)
+    {
+      worstBall = std::max(worstBall, std::abs(monitor->GetDistance(0) - reading.Distance));
+      worstBallClearance = std::max(worstBallClearance, std::abs(monitor->GetClearance(0) - reading.Clearance));
+    }
+    CHECK_BOOL(monitor->GetLevel(0) == vtkVolumeCutNerveMonitor::Contact, reading.Clearance <= 0.0 || monitor->GetClearance(0) <= 0.0);
     // The cylinder at a random pose: its exact distance to the sphere's centre, less the radius.
     vtkNew<vtkMatrix4x4> rasToTool;
     vtkMatrix4x4::Invert(pose->GetMatrix(), rasToTool);
@@ -365,15 +424,18 @@ int TestSphereAccuracyAndTools()
     const double axial = std::max(0.0, std::abs(local[2]) - 2.0);
     const double exact = std::hypot(radial, axial) - radius;
     CHECK_BOOL(monitor->UpdateWithTool(cylinder, pose->GetMatrix()), true);
-    if (exact < 4.0)
+    if (exact < 2.5 && monitor->GetClearance(0) > 0.0)
     {
       worstCylinder = std::max(worstCylinder, std::abs(monitor->GetDistance(0) - exact));
     }
   }
   std::cout << "tools on " << monitor->GetNumberOfToolSamples() << " surface points: ellipsoid ball against the burr max difference " << worstBall
-            << " mm, cylinder burr " << worstCylinder << " mm" << std::endl;
-  CHECK_BOOL(worstBall <= 0.025, true); // points 0.2 mm apart on the ball
-  CHECK_BOOL(worstCylinder <= 0.02 + halfDiagonal, true); // against the analytic sphere: the cubes' half diagonal again
+            << " mm (clearance " << worstBallClearance << " mm), cylinder burr against the analytic sphere " << worstCylinder << " mm" << std::endl;
+  // Points 0.2 mm apart on the ball, and the smoothed field read at them
+  // rather than at the centre (its interpolation between samples).
+  CHECK_BOOL(worstBall <= 0.035, true);
+  CHECK_BOOL(worstBallClearance <= 0.025, true);
+  CHECK_BOOL(worstCylinder <= 0.05, true);
   return EXIT_SUCCESS;
 }
 
@@ -514,9 +576,10 @@ int TestBadInput()
 int TestThreadsAndCost()
 {
   const double spacing[3] = { 0.15, 0.15, 0.15 };
-  const int dims[3] = { 120, 120, 90 };
+  const int dims[3] = { 64, 64, 48 };
   Grid grid(dims, spacing, 10.0);
   vtkNew<vtkVolumeCutNerveMonitor> monitor;
+  monitor->SetRange(3.0);
   monitor->SetGeometry(grid.Dimensions, grid.IJKToRAS);
   double centre[3];
   grid.Centre(centre);
@@ -525,14 +588,14 @@ int TestThreadsAndCost()
   {
     Cylinder nerve;
     const double angle = 2.0 * vtkMath::Pi() * n / 10.0;
-    nerve.Point[0] = centre[0] + 4.0 * std::cos(angle);
-    nerve.Point[1] = centre[1] + 4.0 * std::sin(angle);
+    nerve.Point[0] = centre[0] + 2.5 * std::cos(angle);
+    nerve.Point[1] = centre[1] + 2.5 * std::sin(angle);
     nerve.Point[2] = centre[2];
     nerve.Axis[0] = std::sin(angle);
     nerve.Axis[1] = 0.3;
     nerve.Axis[2] = std::cos(angle);
     vtkMath::Normalize(nerve.Axis);
-    nerve.Radius = 0.4 + 0.1 * n;
+    nerve.Radius = 0.3 + 0.05 * n;
     nerves.push_back(nerve);
     auto labels = grid.Rasterise([&](const double* p) { return nerve.SurfaceDistance(p) <= 0.0; }, 1);
     CHECK_INT(monitor->AddStructure(("nerve " + std::to_string(n)).c_str(), labels, 1), n);
@@ -558,11 +621,11 @@ int TestThreadsAndCost()
 
   vtkNew<vtkMinimalStandardRandomSequence> random;
   random->SetSeed(10);
-  const int queries = 20000;
+  const int queries = 5000;
   std::vector<double> positions(3 * queries);
   for (double& value : positions)
   {
-    value = Random(random, -5.0, 5.0);
+    value = Random(random, -3.0, 3.0);
   }
   std::vector<double> microseconds(queries);
   for (int n = 0; n < queries; ++n)
