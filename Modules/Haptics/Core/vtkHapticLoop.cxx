@@ -7,6 +7,7 @@
 #include "vtkHapticForceModel.h"
 #include "vtkHapticLatestValue.h"
 #include "vtkHapticPendingCuts.h"
+#include "vtkHapticRealTime.h"
 #include "vtkHapticRecorder.h"
 #include "vtkHapticRing.h"
 
@@ -23,25 +24,17 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <string>
 #include <thread>
 #include <vector>
 
-#if defined(__linux__)
-#include <pthread.h>
-#include <sched.h>
-#include <sys/resource.h>
-#endif
-#if defined(_WIN32)
-#include <windows.h>
-#else
-#include <time.h>
-#endif
 
 vtkStandardNewMacro(vtkHapticLoop);
 
 namespace
 {
-using Clock = std::chrono::steady_clock;
+using Clock = vtkHapticRealTime::Clock;
+using ThreadCounters = vtkHapticRealTime::Counters;
 
 enum EventTypes
 {
@@ -93,58 +86,9 @@ struct Display
   double ContactDepth;
 };
 
-/// Processor time (us) the calling thread has used: what a tick costs when
-/// the shared machine's other jobs do not preempt it.
-double ThreadProcessorMicroseconds()
-{
-#if defined(_WIN32)
-  FILETIME creation, exit, kernel, user;
-  if (!GetThreadTimes(GetCurrentThread(), &creation, &exit, &kernel, &user))
-  {
-    return 0.0;
-  }
-  const auto hundreds = [](const FILETIME& time) { return (static_cast<unsigned long long>(time.dwHighDateTime) << 32) | time.dwLowDateTime; };
-  return 0.1 * static_cast<double>(hundreds(kernel) + hundreds(user));
-#else
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
-#endif
-}
-
-/// What the system did to the calling thread so far: page faults it took
-/// (first touches of memory) and the times it took the processor from it.
-struct ThreadCounters
-{
-  long PageFaults = 0;
-  long Preemptions = 0;
-};
-
-ThreadCounters ReadThreadCounters()
-{
-  ThreadCounters counters;
-#if defined(__linux__)
-  rusage usage{};
-  if (getrusage(RUSAGE_THREAD, &usage) == 0)
-  {
-    counters.PageFaults = usage.ru_minflt + usage.ru_majflt;
-    counters.Preemptions = usage.ru_nivcsw;
-  }
-#endif
-  return counters;
-}
-
 unsigned short CountSince(long before, long after)
 {
   return static_cast<unsigned short>(std::min(std::max(after - before, 0L), 65535L));
-}
-
-/// A hint to the processor inside a wait loop.
-inline void Relax()
-{
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
 }
 
 double Percentile(std::vector<float> values, double percent)
@@ -214,6 +158,9 @@ struct vtkHapticLoop::Internals
   std::atomic<unsigned long long> Jittered{ 0 };
   std::atomic<unsigned long long> Overruns{ 0 };
   bool RealTime = false;
+  /// What the haptic thread asked of the system and got (GetRealTimePriorityStatus), set before ThreadReady.
+  std::string RealTimeStatus = "not started";
+  std::atomic<bool> ThreadReady{ false };
   /// Per kept tick, in the same slot as its duration: the force model's,
   /// the cut stroke's and the nerve monitor's time, the shield bricks it
   /// built, the page faults it took and its preemptions.
@@ -750,6 +697,7 @@ bool vtkHapticLoop::Start()
   }
   internal.StopRequested = false;
   internal.RealTime = false;
+  internal.ThreadReady = false;
   internal.Running = true;
   internal.CutInTicks = !(this->AsynchronousCutting && internal.Field);
   if (!internal.CutInTicks)
@@ -763,30 +711,11 @@ bool vtkHapticLoop::Start()
     internal.PreparerStopRequested = false;
     internal.Preparer = std::thread([this]() { this->PrepareShield(); });
   }
-#if defined(__linux__)
-  // Real-time priority and a processor of its own where the system grants
-  // them (it usually refuses both to unprivileged users: then the loop runs
-  // at normal priority and its jitter shows it).
-  sched_param parameters{};
-  parameters.sched_priority = std::min(80, sched_get_priority_max(SCHED_FIFO));
-  internal.RealTime = pthread_setschedparam(internal.Thread.native_handle(), SCHED_FIFO, &parameters) == 0;
-  if (internal.Cutter.joinable())
+  // The thread asks for its priority and processor before its first tick; Start reports what it got.
+  while (!internal.ThreadReady.load(std::memory_order_acquire))
   {
-    // Just below the haptic thread, above everything else: the force reads
-    // the field as the cutter left it, so the cut must not wait for the
-    // machine's other work (its work is bounded: what the ticks queue).
-    sched_param cutter{};
-    cutter.sched_priority = std::max(sched_get_priority_min(SCHED_FIFO), parameters.sched_priority - 1);
-    pthread_setschedparam(internal.Cutter.native_handle(), SCHED_FIFO, &cutter);
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
   }
-  if (this->ProcessorIndex >= 0 && this->ProcessorIndex < CPU_SETSIZE)
-  {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(this->ProcessorIndex, &set);
-    pthread_setaffinity_np(internal.Thread.native_handle(), sizeof(set), &set);
-  }
-#endif
   return true;
 }
 
@@ -851,11 +780,11 @@ bool vtkHapticLoop::RunTicks(int count)
       internal.CutRequestsQueuedBefore(tick > static_cast<unsigned long long>(this->ReplayCutterDelay) ? tick - this->ReplayCutterDelay : 0);
     }
     const Clock::time_point start = Clock::now();
-    const ThreadCounters countersBefore = ReadThreadCounters();
-    const double processorStart = ThreadProcessorMicroseconds();
+    const ThreadCounters countersBefore = vtkHapticRealTime::ReadCounters();
+    const double processorStart = vtkHapticRealTime::ThreadProcessorMicroseconds();
     this->Tick(timeStep);
-    const double processorEnd = ThreadProcessorMicroseconds();
-    const ThreadCounters countersAfter = ReadThreadCounters();
+    const double processorEnd = vtkHapticRealTime::ThreadProcessorMicroseconds();
+    const ThreadCounters countersAfter = vtkHapticRealTime::ReadCounters();
     internal.KeepTick(std::chrono::duration<float, std::micro>(Clock::now() - start).count(),
       static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
   }
@@ -866,6 +795,20 @@ bool vtkHapticLoop::RunTicks(int count)
 void vtkHapticLoop::Run()
 {
   Internals& internal = *this->Internal;
+  vtkHapticRealTime::PrepareThread();
+  if (this->RequestRealTimePriority)
+  {
+    internal.RealTime = vtkHapticRealTime::RequestPriority(this->RealTimePriorityLevel, internal.RealTimeStatus);
+  }
+  else
+  {
+    internal.RealTimeStatus = "not requested (RequestRealTimePriority is off); normal priority";
+  }
+  if (this->ProcessorIndex >= 0 && !vtkHapticRealTime::RunOnProcessor(this->ProcessorIndex))
+  {
+    internal.RealTimeStatus += "; processor " + std::to_string(this->ProcessorIndex) + " refused";
+  }
+  internal.ThreadReady.store(true, std::memory_order_release);
   const Clock::duration period =
     std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / this->Rate));
   const Clock::duration spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(this->SpinTime));
@@ -876,14 +819,7 @@ void vtkHapticLoop::Run()
   bool hasPrevious = false;
   while (!internal.StopRequested.load(std::memory_order_acquire))
   {
-    if (deadline - Clock::now() > spin)
-    {
-      std::this_thread::sleep_until(deadline - spin);
-    }
-    while (Clock::now() < deadline)
-    {
-      Relax();
-    }
+    vtkHapticRealTime::WaitUntil(deadline, spin);
     const Clock::time_point start = Clock::now();
     const size_t capacity = internal.Durations.size();
     if (hasPrevious)
@@ -897,11 +833,11 @@ void vtkHapticLoop::Run()
     hasPrevious = true;
     // The processor time is read inside the wall-clock interval, so that a
     // tick's processor time never exceeds its wall time.
-    const ThreadCounters countersBefore = ReadThreadCounters();
-    const double processorStart = ThreadProcessorMicroseconds();
+    const ThreadCounters countersBefore = vtkHapticRealTime::ReadCounters();
+    const double processorStart = vtkHapticRealTime::ThreadProcessorMicroseconds();
     this->Tick(timeStep);
-    const double processorEnd = ThreadProcessorMicroseconds();
-    const ThreadCounters countersAfter = ReadThreadCounters();
+    const double processorEnd = vtkHapticRealTime::ThreadProcessorMicroseconds();
+    const ThreadCounters countersAfter = vtkHapticRealTime::ReadCounters();
     const Clock::time_point end = Clock::now();
     internal.KeepTick(
       std::chrono::duration<float, std::micro>(end - start).count(), static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
@@ -949,6 +885,14 @@ void vtkHapticLoop::PrepareShield()
 void vtkHapticLoop::CutQueuedSegments()
 {
   Internals& internal = *this->Internal;
+  if (this->RequestRealTimePriority)
+  {
+    // Just below the haptic thread, above everything else: the force reads
+    // the field as the cutter left it, so the cut must not wait for the
+    // machine's other work (its work is bounded: what the ticks queue).
+    std::string status;
+    vtkHapticRealTime::RequestPriority(std::max(1, this->RealTimePriorityLevel - 1), status);
+  }
   for (;;)
   {
     // Read before draining: whatever the ticks queued before the stop request is cut too.
@@ -1466,6 +1410,12 @@ bool vtkHapticLoop::GetRealTimePriority() const
 }
 
 //------------------------------------------------------------------------------
+const char* vtkHapticLoop::GetRealTimePriorityStatus() const
+{
+  return this->Internal->RealTimeStatus.c_str();
+}
+
+//------------------------------------------------------------------------------
 void vtkHapticLoop::ResetStatistics()
 {
   if (this->IsRunning())
@@ -1487,6 +1437,8 @@ void vtkHapticLoop::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DrillButtons: " << this->DrillButtons << "\n";
   os << indent << "SpinTime: " << this->SpinTime << " s\n";
   os << indent << "ProcessorIndex: " << this->ProcessorIndex << "\n";
+  os << indent << "RequestRealTimePriority: " << (this->RequestRealTimePriority ? "on" : "off") << " (level "
+     << this->RealTimePriorityLevel << "): " << this->Internal->RealTimeStatus << "\n";
   os << indent << "StatisticsCapacity: " << this->StatisticsCapacity << "\n";
   os << indent << "Running: " << (this->IsRunning() ? "yes" : "no") << "\n";
   os << indent << "NumberOfTicks: " << this->GetNumberOfTicks() << "\n";

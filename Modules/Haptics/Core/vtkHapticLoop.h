@@ -49,12 +49,22 @@
  * as one undo step), the force is zero. When the device is back the proxy
  * starts again where the hand is, without sweeping from where it left.
  *
- * Timing. Ticks are scheduled on absolute deadlines; the thread sleeps to
- * SpinTime before each deadline and waits the rest actively, which keeps
- * the period's jitter well below 0.1 ms on an idle core. It asks for
- * real-time priority and, if ProcessorIndex is set, for one processor;
- * either may be refused (see GetRealTimePriority). Tick durations and
- * periods are kept for the last StatisticsCapacity ticks.
+ * Timing. Ticks are scheduled on absolute deadlines; the thread sleeps
+ * (clock_nanosleep to the deadline less SpinTime) and waits the rest
+ * actively, which keeps the period's jitter well below 0.1 ms on an idle
+ * core. Before its first tick the thread asks for real-time priority
+ * (RequestRealTimePriority: SCHED_FIFO at RealTimePriorityLevel on Linux,
+ * the cutter one level below; time-critical on Windows), a resident stack,
+ * precise timer wake-ups and, if ProcessorIndex is set, one processor; the
+ * system may refuse priority and processor (then the loop runs at normal
+ * priority: GetRealTimePriorityStatus says why, in one line). Other
+ * processes then preempt the haptic thread whenever the machine is busy.
+ * Because the thread sleeps between its ticks, real-time priority cannot
+ * starve the machine: the thread holds a processor only for a tick's work
+ * and SpinTime. The process's memory is not locked (mlockall): in Slicer it
+ * holds gigabytes of volumes, and a tick touches no new memory (its page
+ * faults are counted, GetTickProfile). Tick durations and periods are kept
+ * for the last StatisticsCapacity ticks.
  *
  * RunTicks performs the same ticks on the calling thread without waiting
  * between them, cutting in the tick (or with a cutter ReplayCutterDelay
@@ -232,6 +242,19 @@ public:
 
   ///@{
   /**
+   * Set/get whether the haptic thread asks the system for real-time
+   * priority (see Timing above), and at which SCHED_FIFO level (1-99; the
+   * cutter asks one below). Defaults: on, 80. Set while stopped.
+   */
+  vtkSetMacro(RequestRealTimePriority, bool);
+  vtkGetMacro(RequestRealTimePriority, bool);
+  vtkBooleanMacro(RequestRealTimePriority, bool);
+  vtkSetClampMacro(RealTimePriorityLevel, int, 1, 99);
+  vtkGetMacro(RealTimePriorityLevel, int);
+  ///@}
+
+  ///@{
+  /**
    * Set/get the processor the thread asks to run on (-1: any). Default is -1.
    */
   vtkSetMacro(ProcessorIndex, int);
@@ -329,7 +352,17 @@ public:
   double GetPeriodJitterPercentile(double percent) const;
   double GetMaximumPeriodJitter() const;
   unsigned long long GetNumberOfOverruns() const;
+  ///@}
+
+  ///@{
+  /**
+   * Whether the system granted the haptic thread real-time priority at its
+   * last Start, and what the thread got, in one line: the policy and level,
+   * or why it runs at normal priority (not requested, or the system's
+   * refusal and what would permit it, e.g. CAP_SYS_NICE or RLIMIT_RTPRIO).
+   */
   bool GetRealTimePriority() const;
+  const char* GetRealTimePriorityStatus() const;
   ///@}
 
   ///@{
@@ -413,6 +446,8 @@ protected:
   unsigned int DrillButtons = 1u;
   double SpinTime = 0.0002;
   int ProcessorIndex = -1;
+  bool RequestRealTimePriority = true;
+  int RealTimePriorityLevel = 80;
   int StatisticsCapacity = 100000;
   bool PrepareShieldAhead = true;
   double ShieldLookAhead = 3.0;

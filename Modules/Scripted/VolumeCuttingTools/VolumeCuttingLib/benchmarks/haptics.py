@@ -38,10 +38,22 @@ device in the air of a 4-voxel CT, ``hapticsjob.idle_loop``): its longest
 tick and its overruns are this machine's own scheduling noise, against which
 the replays' figures are read. The slowest ticks' profiles (force model,
 cut, monitor, page faults, preemptions) are kept with the rows.
+
+Real-time priority: the temporal-bone replay and a replay on the example
+head CT (no segmentation, beside the main job's right mastoidectomy), each
+with the loop's threads at real-time priority (SCHED_FIFO, the default where
+the system grants it) and at normal priority, alternating in the same
+minutes, with the do-nothing loop at both priorities before each pair: once
+on the machine as it is (other jobs share it) and once with busy processes
+added. The processor time the host took from this virtual machine meanwhile
+(/proc/stat's steal) is kept with the do-nothing rows: no priority inside
+the machine wins that back.
 """
 
 from __future__ import annotations
 
+import contextlib
+import subprocess
 import tempfile
 import time
 from pathlib import Path
@@ -51,7 +63,8 @@ import numpy as np
 import slicer
 import vtk
 
-from ..data import temporalbone
+from ..cutting import drilling
+from ..data import headct, temporalbone
 from ..jobs import hapticsjob
 from ..scene import nodes
 from ..scene.application import HeadlessSlicer, opengl_renderer_name
@@ -200,19 +213,34 @@ def _force_difference(forces: np.ndarray, reference: np.ndarray) -> tuple[int, f
     return int(np.sum(differences > FELT_DIFFERENCE_N)), float(np.median(differences)) if count else 0.0
 
 
-def _temporal_bone_replays(out_dir: Path, machine) -> list[dict]:
-    """Replays on the temporal-bone case in each of ``REPLAY_MODES``, in alternating rounds."""
-
+def _temporal_bone_scene():
+    """The temporal-bone case loaded as a user's files, its 11 structures protected: (application, cut node, plan)."""
     application = HeadlessSlicer()
     files = temporalbone.cached_case_files()
     volume, segmentation, cuttable, protected = temporalbone.load_case(application.scene, files)
-    logic = application.volume_cutting_logic
-    cut_node = logic.AddVolumeCutNode(volume, segmentation)
+    cut_node = application.volume_cutting_logic.AddVolumeCutNode(volume, segmentation)
     cut_node.SetCuttableSegmentIDs(cuttable)
     cut_node.SetProtectedSegmentIDs(protected)
     cut_node.SetSurfaceIsoValue(300.0)
     plan = SimpleNamespace(**{key: np.asarray(value) if isinstance(value, tuple) else value
                               for key, value in TEMPORAL_BONE_PLAN.items()})
+    return application, cut_node, plan
+
+
+def _head_ct_scene():
+    """The example head CT without segmentation, drilled beside the main job's right mastoidectomy."""
+    application = HeadlessSlicer()
+    volume = headct.load_volume_node(application.scene, name="HeadCT")
+    cut_node = application.volume_cutting_logic.AddVolumeCutNode(volume, None)
+    cut_node.SetSurfaceIsoValue(300.0)
+    return application, cut_node, drilling.MastoidectomyPlan(entry=drilling.lateral_entry(volume, *headct.RIGHT_MASTOID_YZ))
+
+
+def _temporal_bone_replays(scene, out_dir: Path, machine) -> list[dict]:
+    """Replays on the temporal-bone case in each of ``REPLAY_MODES``, in alternating rounds."""
+
+    application, cut_node, plan = scene
+    logic = application.volume_cutting_logic
     protection = logic.GetCutField(cut_node).GetProtection()
     runs = {mode: [] for mode in REPLAY_MODES}
     # Per round, each mode's forces against the same round's replay cutting in the ticks.
@@ -400,7 +428,10 @@ def haptics(repeats: int) -> list[dict]:
         contact_rows, whole_voxel_s = _contact_ratio(cut_node, out_dir, machine)
         surface = np.array(quiet["surface_ras_mm"])
         first_s = _first_call(cut_node, surface + 1.0 * plan.direction)
-        temporal_bone_rows = _temporal_bone_replays(out_dir, machine)
+        temporal_bone = _temporal_bone_scene()
+        temporal_bone_rows = _temporal_bone_replays(temporal_bone, out_dir, machine)
+        priority_rows = _priority_replays({"temporal-bone case": temporal_bone, "head CT": _head_ct_scene()}, out_dir,
+                                          machine)
 
     what = (f"one haptic tick at 1 kHz (device read, 82-point contact, force, proxy, cut stroke of a 4 mm burr, "
             f"recording) while the 3D view renders continuously in the main thread "
@@ -436,4 +467,104 @@ def haptics(repeats: int) -> list[dict]:
     results.append(measurement(
         "cut volume of the replayed session while rendering (mm^3)", rendering["removed_volume_mm3"], "mm^3",
         "the same session without rendering (determinism: ratio 1)", quiet["removed_volume_mm3"], 1, machine))
-    return results + temporal_bone_rows
+    return results + temporal_bone_rows + priority_rows
+
+
+#: Rounds of the real-time priority A/B: per round and load, the do-nothing loop and each case's replay with and
+#: without real-time priority, the order alternating between rounds.
+PRIORITY_ROUNDS = 2
+#: Busy processes (``yes``) started for the loaded half of the A/B, on top of the machine's own other work.
+BUSY_PROCESSES = 3
+
+
+@contextlib.contextmanager
+def _busy(count: int):
+    """``count`` processes that keep a processor busy each (writing to /dev/null) while the block runs."""
+    processes = [subprocess.Popen(["yes"], stdout=subprocess.DEVNULL) for _ in range(count)]
+    try:
+        yield
+    finally:
+        for process in processes:
+            process.kill()
+            process.wait()
+
+
+def _stolen_ms() -> float:
+    """Processor time the host took from this virtual machine's processors so far (ms; 0 where not reported)."""
+    try:
+        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
+        return 10.0 * float(fields[8])  # USER_HZ 100: the "steal" column of the "cpu" line
+    except (OSError, IndexError, ValueError):
+        return 0.0
+
+
+def _priority_replays(scenes: dict, out_dir: Path, machine) -> list[dict]:
+    """The same replays with and without real-time priority, alternating, on a quiet and a loaded machine.
+
+    For each load (the machine as it is, then with ``BUSY_PROCESSES`` busy
+    processes more) and round: the do-nothing loop, then each scene's replay
+    (cutter thread, pending cuts felt, shield preparer: the defaults), first
+    with real-time priority and then without (the other way round in odd
+    rounds). The cut and the shield are forgotten before each replay.
+    """
+    runs, idle, stolen = {}, {}, {}
+    for busy in (0, BUSY_PROCESSES):
+        with _busy(busy):
+            for round_index in range(PRIORITY_ROUNDS):
+                for real_time in ((True, False) if round_index % 2 == 0 else (False, True)):
+                    before = _stolen_ms()
+                    idle.setdefault((busy, real_time), []).append(hapticsjob.idle_loop(real_time_priority=real_time))
+                    for case, (application, cut_node, plan) in scenes.items():
+                        application.volume_cutting_logic.ClearCut(cut_node)
+                        application.volume_cutting_logic.GetCutField(cut_node).GetProtection().ClearBricks()
+                        folder = out_dir / f"priority-{busy}-{round_index}-{real_time}-{case.split()[0]}"
+                        folder.mkdir()
+                        runs.setdefault((case, busy, real_time), []).append(
+                            hapticsjob.run(application, cut_node, plan, folder, real_time_priority=real_time))
+                    stolen[(busy, real_time)] = stolen.get((busy, real_time), 0.0) + _stolen_ms() - before
+    granted = runs[(next(iter(scenes)), 0, True)][0]["real_time_priority_status"]
+    results = []
+    for busy in (0, BUSY_PROCESSES):
+        load = "the machine as it is" if not busy else f"{busy} busy processes ('yes') added"
+        for case in scenes:
+            fast, slow = runs[(case, busy, True)], runs[(case, busy, False)]
+            ticks = sum(replay["ticks_run"] for replay in fast)
+            protected = fast[0]["protected_segments"]
+            where = (f"{case} ({protected} protected structures), replayed drilling, {load}, "
+                     f"real-time priority ({granted})")
+            baseline = "the same replays at normal priority, alternating with them in the same run"
+            for label, key, combine in (("p50", "tick_us_p50", np.median), ("p99", "tick_us_p99", np.median),
+                                        ("max", "tick_us_max", np.max)):
+                results.append(measurement(
+                    f"one haptic tick on the {where}: {label} ({'median' if label != 'max' else 'max'} of "
+                    f"{PRIORITY_ROUNDS} replays)", float(combine([replay[key] for replay in fast])), "us",
+                    f"{baseline}: {label}", float(combine([replay[key] for replay in slow])), ticks, machine))
+            row = measurement(f"haptic loop overruns on the {where} (all replays)",
+                              sum(replay["overruns"] for replay in fast), "ticks", baseline,
+                              sum(replay["overruns"] for replay in slow), 1, machine)
+            # Where the slowest ticks' time went: the tick's own processor time against the wall time it took.
+            row["slowest_ticks"] = {"real_time": [tick for replay in fast for tick in replay["tick_profile"]["slowest"][:3]],
+                                    "normal": [tick for replay in slow for tick in replay["tick_profile"]["slowest"][:3]]}
+            row["slow_ticks_processor_bound"] = {
+                "real_time": sum(replay["tick_profile"]["slow_ticks_processor_bound"] for replay in fast),
+                "normal": sum(replay["tick_profile"]["slow_ticks_processor_bound"] for replay in slow)}
+            row["page_faults_in_ticks"] = {"real_time": sum(replay["tick_profile"]["page_faults"] for replay in fast),
+                                           "normal": sum(replay["tick_profile"]["page_faults"] for replay in slow)}
+            results.append(row)
+        fast, slow = idle[(busy, True)], idle[(busy, False)]
+        ticks = sum(run["ticks_run"] for run in fast)
+        for label, key in (("max", "tick_us_max"), ("overruns", "overruns")):
+            row = measurement(
+                f"the machine's own noise, {load}: the do-nothing 1 kHz loop at real-time priority, {label} "
+                f"(all {PRIORITY_ROUNDS} runs of 4.5 s)", float(np.max([run[key] for run in fast]) if label == "max"
+                                                               else sum(run[key] for run in fast)),
+                "us" if label == "max" else "ticks", f"the same loop at normal priority, same run: {label}",
+                float(np.max([run[key] for run in slow]) if label == "max" else sum(run[key] for run in slow)),
+                ticks if label == "max" else 1, machine)
+            # Time the host took from this VM's processors meanwhile (no priority inside the VM can win it back).
+            row["host_steal_ms"] = {"real_time": round(stolen[(busy, True)], 1), "normal": round(stolen[(busy, False)], 1)}
+            results.append(row)
+    for row in results:
+        row["real_time_priority"] = runs[(next(iter(scenes)), 0, True)][0]["real_time_priority"]
+        row["real_time_priority_status"] = granted
+    return results

@@ -130,6 +130,8 @@ def tick_profile(loop, slowest: int = 5) -> dict:
         "slow_ticks": int(len(slow)),
         # Slow ticks whose own compute (processor time) was not slow: the machine took the time.
         "slow_ticks_preempted": int(np.sum((slow[:, 1] <= SLOW_TICK_US) & (slow[:, 7] > 0))),
+        # Slow ticks whose processor time was slow too: the tick's own work, or interrupts handled on its processor.
+        "slow_ticks_processor_bound": int(np.sum(slow[:, 1] > SLOW_TICK_US)),
         "page_faults": int(profiles[:, 6].sum()),
         "ticks_with_page_faults": int(np.sum(profiles[:, 6] > 0)),
         "preemptions": int(profiles[:, 7].sum()),
@@ -140,13 +142,15 @@ def tick_profile(loop, slowest: int = 5) -> dict:
     }
 
 
-def idle_loop(seconds: float = 4.5) -> dict:
+def idle_loop(seconds: float = 4.5, real_time_priority: bool = True) -> dict:
     """The machine's own noise: the haptic loop at 1 kHz on the same thread set-up, with ticks that do next to nothing.
 
     A virtual device held still in the air of a 4-voxel CT, no cut field, no
     monitor: a tick is a device read and a force-model step out of contact
     (a few microseconds), so its longest durations, overruns and jitter are
     what the scheduler of this machine gives any 1 kHz thread.
+    ``real_time_priority`` False runs it at normal priority
+    (``vtkHapticLoop.SetRequestRealTimePriority``).
     """
     model = forcecoupling.air_force_model()
     device = slicer.vtkVirtualHapticDevice()
@@ -157,6 +161,7 @@ def idle_loop(seconds: float = 4.5) -> dict:
     loop.SetRate(RATE_HZ)
     loop.SetDevice(device)
     loop.SetForceModel(model)
+    loop.SetRequestRealTimePriority(bool(real_time_priority))
     if not loop.Start():
         raise RuntimeError("the idle haptic loop could not start (see the log)")
     time.sleep(seconds)
@@ -172,6 +177,7 @@ def idle_loop(seconds: float = 4.5) -> dict:
         "period_jitter_us_max": round(loop.GetMaximumPeriodJitter(), 1),
         "overruns": int(loop.GetNumberOfOverruns()),
         "real_time_priority": bool(loop.GetRealTimePriority()),
+        "real_time_priority_status": loop.GetRealTimePriorityStatus(),
         "profile": tick_profile(loop),
     }
 
@@ -197,7 +203,7 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
 
 
 def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None,
-        asynchronous_cutting: bool = True, feel_pending_cuts: bool = True) -> dict:
+        asynchronous_cutting: bool = True, feel_pending_cuts: bool = True, real_time_priority: bool = True) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
@@ -210,7 +216,9 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     cutter thread (``vtkHapticLoop.SetAsynchronousCutting``); ``feel_pending_cuts`` False
     leaves out the segments queued and not cut yet from the force model
     (``vtkHapticLoop.SetFeelPendingCuts``: the proxy then meets the bone the
-    cutter has not reached).
+    cutter has not reached); ``real_time_priority`` False runs the loop's
+    threads at normal priority (``vtkHapticLoop.SetRequestRealTimePriority``;
+    on, the system may still refuse: ``real_time_priority_status`` says why).
     The replayed ticks are also saved as a complete recording
     (``haptic_session.json``, ``recording.from_haptic_ticks``) on ``scan``
     (the scan descriptor a recording names), for grading.
@@ -246,6 +254,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     loop.SetPrepareShieldAhead(bool(prepare_shield_ahead))
     loop.SetAsynchronousCutting(bool(asynchronous_cutting))
     loop.SetFeelPendingCuts(bool(feel_pending_cuts))
+    loop.SetRequestRealTimePriority(bool(real_time_priority))
     replayed = slicer.vtkHapticRecorder()
     replayed.SetCapacity(ticks + 1000)
     loop.SetRecorder(replayed)
@@ -371,6 +380,7 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "ticks_building_shield": int(loop.GetNumberOfTicksBuildingShield()),
         "tick_us_max_building_shield": round(loop.GetMaximumTickDurationBuildingShield(), 1),
         "real_time_priority": bool(loop.GetRealTimePriority()),
+        "real_time_priority_status": loop.GetRealTimePriorityStatus(),
         "tick_profile": tick_profile(loop),
         "nerve_monitor": nerve_monitor,
         "wall_s": round(wall_s, 2),

@@ -557,6 +557,10 @@ def main(argv=None) -> int:
     print(json.dumps(summary, indent=2))
     for warning in summary.get("own_data", {}).get("warnings", []):
         print(f"warning: {warning}", file=sys.stderr)
+    haptics = summary.get("haptics", {})
+    if haptics and not haptics.get("real_time_priority"):
+        # The one line a user needs to read the haptic figures: the loop ran at normal priority, and why.
+        print(f"note: the haptic loop ran at normal priority: {haptics.get('real_time_priority_status')}", file=sys.stderr)
     return 0 if summary["inputs_ok"] else 1
 
 
