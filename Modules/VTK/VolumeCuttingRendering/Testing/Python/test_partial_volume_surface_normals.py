@@ -46,12 +46,7 @@ def box_filtered_ball():
             for dx in offsets:
                 inside += (x + dx - CENTRE[0]) ** 2 + (y + dy - CENTRE[1]) ** 2 + (z + dz - CENTRE[2]) ** 2 < RADIUS**2
     values = 1000.0 * inside / SUBSAMPLES**3
-    image = vtk.vtkImageData()
-    image.SetDimensions(DIMENSIONS, DIMENSIONS, DIMENSIONS)
-    array = numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True)
-    array.SetName("CT")
-    image.GetPointData().SetScalars(array)
-    return image
+    return A.ct_image(values)
 
 
 def head_on_camera():
