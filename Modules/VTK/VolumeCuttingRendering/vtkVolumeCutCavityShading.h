@@ -51,14 +51,37 @@ public:
   }
 
   /**
-   * Length (mm, at most the range) of original material between a
-   * surface's point (IJK) and the eye, along \a view (world, unit, towards the eye).
+   * Darken a surface's shaded colour by its depth under the original
+   * surface. Where the point a quarter step before it is not in original
+   * material, the depth is under a quarter step (a shade of at most 2 %
+   * at the default radius), taken as none: the colour of every surface with
+   * air before it is left exactly as it is, at the cost of one sample.
    */
-  double Depth(const double index[3], const double view[3]) const
+  void Apply(const double index[3], const double view[3], float rgb[3]) const
   {
-    const double range = RangeShare * this->Scene.AmbientOcclusionRadius;
     double step[3];
     this->Step(view, step);
+    if (!this->InOriginalMaterial(index, step, 0.25))
+    {
+      return;
+    }
+    const double share = 1.0 - this->Depth(index, step) / (RangeShare * this->Scene.AmbientOcclusionRadius);
+    const float factor = static_cast<float>(1.0 - Strength * (1.0 - share * share));
+    for (int c = 0; c < 3; ++c)
+    {
+      rgb[c] *= factor;
+    }
+  }
+
+private:
+  /**
+   * Length (mm, at most the range) of original material between a
+   * surface's point (IJK) and the eye, found in steps of \a step (IJK,
+   * towards the eye: Step of the view, computed once by Apply).
+   */
+  double Depth(const double index[3], const double step[3]) const
+  {
+    const double range = RangeShare * this->Scene.AmbientOcclusionRadius;
     // Last step in the material and first out of it, in steps from the point.
     double inside = 0.0;
     double outside = -1.0;
@@ -78,30 +101,6 @@ public:
     return 0.5 * (inside + outside) * range / Steps;
   }
 
-  /**
-   * Darken a surface's shaded colour by its depth under the original
-   * surface. Where the point a quarter step before it is not in original
-   * material, the depth is under a quarter step (a shade of at most 2 %
-   * at the default radius), taken as none: the colour of every surface with
-   * air before it is left exactly as it is, at the cost of one sample.
-   */
-  void Apply(const double index[3], const double view[3], float rgb[3]) const
-  {
-    double step[3];
-    this->Step(view, step);
-    if (!this->InOriginalMaterial(index, step, 0.25))
-    {
-      return;
-    }
-    const double share = 1.0 - this->Depth(index, view) / (RangeShare * this->Scene.AmbientOcclusionRadius);
-    const float factor = static_cast<float>(1.0 - Strength * (1.0 - share * share));
-    for (int c = 0; c < 3; ++c)
-    {
-      rgb[c] *= factor;
-    }
-  }
-
-private:
   /// One step (IJK) along \a view (world, unit).
   void Step(const double view[3], double step[3]) const
   {

@@ -11,17 +11,31 @@ uniform float diffuseK;
 uniform float specularK;
 uniform float specularPower;
 
+// The object field's gradient by 3D Sobel differences gradientStep voxels
+// apart: no contour rings where partial volume ramps a surface
+// (vtkVolumeCutSurfaceShader::SobelGradient says why).
 vec3 objectNormal(int object, vec3 p)
 {
-  vec3 gradient;
+  vec3 gradient = vec3(0.0);
   bool shape = hasLabels != 0 && styleSurface(object).y > 0.5;
-  for (int axis = 0; axis < 3; ++axis)
+  for (int k = -1; k <= 1; ++k)
   {
-    vec3 plus = p;
-    vec3 minus = p;
-    plus[axis] += gradientStep;
-    minus[axis] -= gradientStep;
-    gradient[axis] = shape ? indicator(object, plus) - indicator(object, minus) : intensity(plus) - intensity(minus);
+    for (int j = -1; j <= 1; ++j)
+    {
+      for (int i = -1; i <= 1; ++i)
+      {
+        if (i == 0 && j == 0 && k == 0)
+        {
+          continue;
+        }
+        vec3 o = vec3(float(i), float(j), float(k));
+        vec3 q = p + gradientStep * o;
+        float value = shape ? indicator(object, q) : intensity(q);
+        // Weight 2 where the point lies on the axis's line across, 1 off it.
+        vec3 w = vec3(i == 0 ? 2.0 : 1.0, j == 0 ? 2.0 : 1.0, k == 0 ? 2.0 : 1.0);
+        gradient += value * o * vec3(w.y * w.z, w.x * w.z, w.x * w.y);
+      }
+    }
   }
   return normalize(-(normalMatrix * gradient));
 }

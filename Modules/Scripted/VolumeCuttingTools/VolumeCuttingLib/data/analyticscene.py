@@ -89,12 +89,7 @@ class CubeScene:
         inside = np.minimum(np.maximum(np.maximum(qx, qy), qz), 0)
         width = np.float32(self.ramp_voxels * self.spacing)
         values = np.float32(self.bone) * np.clip(np.float32(0.5) - (outside + inside) / width, 0, 1)
-        image = vtk.vtkImageData()
-        image.SetDimensions(n, n, n)
-        array = numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True)
-        array.SetName("CT")
-        image.GetPointData().SetScalars(array)
-        return image
+        return ct_image(values)
 
     def iso_value(self) -> float:
         return 0.5 * self.bone
@@ -255,6 +250,17 @@ class CubeScene:
         second_surface = np.sort(self.surface_distances(points), axis=1)[:, 1]
         second_face = np.sort(np.abs(np.abs(points - self.center) - self.half_size), axis=1)[:, 1]
         return np.minimum(second_surface, second_face)
+
+
+def ct_image(values: np.ndarray) -> vtk.vtkImageData:
+    """A CT (float32 scalars named "CT") from an array indexed [k, j, i], at unit spacing."""
+    nk, nj, ni = values.shape
+    image = vtk.vtkImageData()
+    image.SetDimensions(ni, nj, nk)
+    array = numpy_support.numpy_to_vtk(np.ascontiguousarray(values, dtype=np.float32).ravel(), deep=True)
+    array.SetName("CT")
+    image.GetPointData().SetScalars(array)
+    return image
 
 
 def default_scene(dimensions: int = 64) -> CubeScene:

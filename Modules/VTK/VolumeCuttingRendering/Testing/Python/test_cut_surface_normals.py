@@ -41,12 +41,7 @@ def noisy_ball_ct():
     radius = np.sqrt((x - BALL_CENTRE[0]) ** 2 + (y - BALL_CENTRE[1]) ** 2 + (z - BALL_CENTRE[2]) ** 2)
     values = 1000.0 * np.clip(0.5 - (radius - BALL_RADIUS) / (2.0 * SPACING), 0.0, 1.0)
     values += np.random.default_rng(28).normal(0.0, 15.0, values.shape)
-    image = vtk.vtkImageData()
-    image.SetDimensions(DIMENSIONS, DIMENSIONS, DIMENSIONS)
-    array = numpy_support.numpy_to_vtk(values.astype(np.float32).ravel(), deep=True)
-    array.SetName("CT")
-    image.GetPointData().SetScalars(array)
-    return image
+    return A.ct_image(values)
 
 
 def ijk_to_ras():
