@@ -347,7 +347,8 @@ class DrillSession:
         """Make a segment cuttable, protected or neither ("")."""
         self._require_data()
         if role not in ROLES:
-            raise SessionError(f"Role {role!r} of segment '{segment_id}' is not one of cuttable, protected or none")
+            raise SessionError(f"Role {role!r} of segment '{segment_id}' is not one of 'cuttable', 'protected' "
+                               "or '' (none)")
         if self.segmentation.GetSegmentation().GetSegment(segment_id) is None:
             raise SessionError(f"There is no segment '{segment_id}' in {self.segmentation.GetName()}")
         cuttable = [s for s in self.cut_node.GetCuttableSegmentIDs() if s != segment_id]
