@@ -15,20 +15,13 @@ import slicer_volumecutting as vc
 import vtk
 from vtkmodules.util import numpy_support
 
-SIZE = 40
+from test_partial_volume_labels import SIZE, image  # a 48^3 grid of 0.5 mm voxels
+
 WIDTH = 80
 ISO = 300.0
 # label: (centre in voxels, radius in voxels, HU)
-BALLS = {1: ((14.0, 20.0, 20.0), 9.3, 1500.0), 2: ((28.0, 14.0, 20.0), 5.2, 60.0), 3: ((28.0, 27.0, 21.0), 6.1, 80.0)}
+BALLS = {1: ((18.0, 24.0, 24.0), 9.3, 1500.0), 2: ((32.0, 18.0, 24.0), 5.2, 60.0), 3: ((32.0, 31.0, 25.0), 6.1, 80.0)}
 COLORS = {1: (0.94, 0.84, 0.57), 2: (0.9, 0.8, 0.2), 3: (0.7, 0.2, 0.2)}
-
-
-def image(array):
-    data = vtk.vtkImageData()
-    data.SetDimensions(SIZE, SIZE, SIZE)
-    data.SetSpacing(0.5, 0.5, 0.5)
-    data.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(array).ravel(), deep=True))
-    return data
 
 
 def scene_images():
