@@ -52,6 +52,11 @@ struct vtkMRMLVolumeCutDisplayableManager::Internals
     vtkVolumeCutField* PreviewField = nullptr;
     std::string LabelSource;
     std::string FractionSource;
+    /// What was last given to the caster as appearances (colour, opacity,
+    /// shape or iso-value, surface colour per shown segment): setting them
+    /// again unchanged would still modify the caster, which then rebuilds
+    /// what depends on appearances and draws the whole view again.
+    std::vector<double> Appearances;
   };
   std::map<vtkMRMLVolumeCutNode*, Pipeline> Pipelines;
   std::set<vtkMRMLVolumeCutNode*> NodesInStroke;
@@ -331,6 +336,7 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
     pipeline.Labels = nullptr;
     pipeline.LabelSource.clear();
     pipeline.FractionSource.clear();
+    pipeline.Appearances.clear();
   }
   else
   {
@@ -341,40 +347,53 @@ void vtkMRMLVolumeCutDisplayableManager::UpdatePipeline(vtkMRMLVolumeCutNode* no
       caster->SetLabelMap(pipeline.Labels);
       pipeline.LabelSource = source.str();
     }
-    caster->RemoveAllSegmentAppearances();
-    for (size_t index = 0; index < shown.size(); ++index)
+    for (size_t index = 0; index < shown.size() && pipeline.LabelSource != pipeline.FractionSource; ++index)
     {
       // Segments with fractional labelmaps (up to 16) are placed at sub-voxel
       // accuracy; the others by their binary labelmap.
-      if (pipeline.LabelSource != pipeline.FractionSource)
-      {
-        vtkNew<vtkImageData> fraction;
-        const bool hasFraction = index < 16 &&
-          vtkSlicerVolumeCuttingLogic::CreateSegmentFractionOnAnatomyGrid(node, shown[index], fraction);
-        caster->SetSegmentFraction(static_cast<int>(index + 1), hasFraction ? fraction.GetPointer() : nullptr);
-      }
-      const std::string& id = shown[index];
-      double color[3] = { 1.0, 1.0, 1.0 };
-      segmentation->GetSegmentation()->GetSegment(id)->GetColor(color);
-      const double opacity = display->GetSegmentOpacity3D(id);
-      const double iso = node->IsSegmentCuttable(id) ? node->GetSurfaceIsoValue() : std::numeric_limits<double>::quiet_NaN();
-      caster->SetSegmentAppearance(static_cast<int>(index + 1), color, opacity, iso);
+      vtkNew<vtkImageData> fraction;
+      const bool hasFraction =
+        index < 16 && vtkSlicerVolumeCuttingLogic::CreateSegmentFractionOnAnatomyGrid(node, shown[index], fraction);
+      caster->SetSegmentFraction(static_cast<int>(index + 1), hasFraction ? fraction.GetPointer() : nullptr);
     }
     // Segments of one material: uncut surfaces in the colour of the first.
     const std::vector<std::string> material = node->GetMaterialSegmentIDs();
     auto first = std::find_if(material.begin(), material.end(),
       [&](const std::string& id) { return segmentation->GetSegmentation()->GetSegment(id) != nullptr; });
+    double materialColor[3] = { 1.0, 1.0, 1.0 };
     if (first != material.end())
     {
-      double materialColor[3] = { 1.0, 1.0, 1.0 };
       segmentation->GetSegmentation()->GetSegment(*first)->GetColor(materialColor);
+    }
+    constexpr size_t AppearanceSize = 9; // colour, opacity, shape, iso, surface colour
+    std::vector<double> appearances;
+    appearances.reserve(AppearanceSize * shown.size());
+    for (const std::string& id : shown)
+    {
+      double color[3] = { 1.0, 1.0, 1.0 };
+      segmentation->GetSegmentation()->GetSegment(id)->GetColor(color);
+      const bool cuttable = node->IsSegmentCuttable(id);
+      const bool ofMaterial = first != material.end() && std::find(material.begin(), material.end(), id) != material.end();
+      const double* surface = ofMaterial ? materialColor : color;
+      appearances.insert(appearances.end(), { color[0], color[1], color[2], display->GetSegmentOpacity3D(id), cuttable ? 0.0 : 1.0,
+                                              cuttable ? node->GetSurfaceIsoValue() : 0.0, surface[0], surface[1], surface[2] });
+    }
+    if (appearances != pipeline.Appearances)
+    {
+      caster->RemoveAllSegmentAppearances();
       for (size_t index = 0; index < shown.size(); ++index)
       {
-        if (std::find(material.begin(), material.end(), shown[index]) != material.end())
+        const double* appearance = appearances.data() + AppearanceSize * index;
+        const int label = static_cast<int>(index + 1);
+        // NaN: drawn by its shape (a segment that is not cut shows its own surface).
+        caster->SetSegmentAppearance(
+          label, appearance, appearance[3], appearance[4] != 0.0 ? std::numeric_limits<double>::quiet_NaN() : appearance[5]);
+        if (!std::equal(appearance, appearance + 3, appearance + 6))
         {
-          caster->SetSegmentSurfaceColor(static_cast<int>(index + 1), materialColor);
+          caster->SetSegmentSurfaceColor(label, appearance + 6);
         }
       }
+      pipeline.Appearances.swap(appearances);
     }
     pipeline.FractionSource = pipeline.LabelSource;
   }

@@ -10,6 +10,7 @@
 //------------------------------------------------------------------------------
 void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximumThreads)
 {
+  static_assert(BlockSize == vtkVolumeCutRayScene::FractionBlockSize, "the fractions' non-zero blocks are these blocks");
   const int* dims = scene.Dimensions;
   for (int axis = 0; axis < 3; ++axis)
   {
@@ -99,7 +100,10 @@ void vtkVolumeCutEmptySpace::Build(const vtkVolumeCutRayScene& scene, int maximu
             {
               const vtkVolumeCutRayScene::SegmentStyle& style =
                 fraction.Label < static_cast<int>(styles.size()) ? styles[fraction.Label] : styles[0];
-              if (occupied || style.Opacity <= 0.f || (!style.Shape && hi < style.Iso))
+              // The fraction's own blocks are these blocks: one known to be
+              // all 0 cannot hold it (smoothed fractions cover a few percent).
+              if (occupied || style.Opacity <= 0.f || (!style.Shape && hi < style.Iso) ||
+                (fraction.NonZeroBlocks.size() == static_cast<size_t>(blockCount) && !fraction.NonZeroBlocks[block]))
               {
                 continue;
               }
@@ -185,6 +189,9 @@ void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int m
   const size_t gy = this->GroupDimensions[1];
   this->CellGroups.assign(gx * gy * this->GroupDimensions[2], 0);
   const vtkIdType sliceSize = static_cast<vtkIdType>(dims[0]) * dims[1];
+  constexpr int FractionBlock = vtkVolumeCutRayScene::FractionBlockSize;
+  int fractionBlocks[3];
+  scene.GetFractionBlockDimensions(fractionBlocks);
   // Each thread builds whole layers of groups (two layers of cells).
   vtkVolumeCutParallelFor(maximumThreads, this->GroupDimensions[2], [&](vtkIdType beginGroupZ, vtkIdType endGroupZ) {
     const vtkIdType beginZ = 2 * beginGroupZ;
@@ -212,12 +219,39 @@ void vtkVolumeCutEmptySpace::BuildCells(const vtkVolumeCutRayScene& scene, int m
         // otherwise weigh the labels.
         const bool shape = from == Always;
         constexpr float Half = 0.5f * (1.f - 1e-5f);
-        for (vtkIdType v = 0; v < sliceSize; ++v)
-        {
-          const float value = fraction.Values[offset + v];
-          if (shape ? value >= Half : value > 0.f)
+        auto mark = [&](vtkIdType begin, vtkIdType end) {
+          for (vtkIdType v = begin; v < end; ++v)
           {
-            needed[v] = std::min(needed[v], from);
+            const float value = fraction.Values[offset + v];
+            if (shape ? value >= Half : value > 0.f)
+            {
+              needed[v] = std::min(needed[v], from);
+            }
+          }
+        };
+        if (fraction.NonZeroBlocks.size() != static_cast<size_t>(fractionBlocks[0]) * fractionBlocks[1] * fractionBlocks[2])
+        {
+          mark(0, sliceSize);
+          continue;
+        }
+        // Only the runs of voxels in blocks where the fraction is above 0
+        // somewhere: a voxel lies in the block of the cells it starts, the
+        // last one along an axis in the block of the cell it ends.
+        const int blockZ = std::min(k / FractionBlock, fractionBlocks[2] - 1);
+        for (int j = 0; j < dims[1]; ++j)
+        {
+          const int blockY = std::min(j / FractionBlock, fractionBlocks[1] - 1);
+          const uint8_t* row =
+            fraction.NonZeroBlocks.data() + fractionBlocks[0] * (blockY + static_cast<size_t>(fractionBlocks[1]) * blockZ);
+          for (int blockX = 0; blockX < fractionBlocks[0]; ++blockX)
+          {
+            if (row[blockX])
+            {
+              const vtkIdType first = static_cast<vtkIdType>(dims[0]) * j + blockX * FractionBlock;
+              const vtkIdType last = static_cast<vtkIdType>(dims[0]) * j +
+                (blockX + 1 == fractionBlocks[0] ? dims[0] : (blockX + 1) * FractionBlock);
+              mark(first, last);
+            }
           }
         }
       }

@@ -37,6 +37,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <vector>
@@ -89,7 +90,14 @@ struct vtkVolumeCutRayCaster::Internals
   size_t GivenFractions = 0; // Scene.Fractions: the given ones first, then the smoothed ones
   std::vector<int> SmoothedLabels;
   double SmoothedSigma = 0.0;
+  /// GivenLabelVersion when the smoothed fractions were made: a shown
+  /// segment keeps its given voxels in Scene.Labels, so its smoothed
+  /// fraction stays valid while the given labels and the sigma do.
   vtkMTimeType SmoothedLabelVersion = 0;
+  vtkMTimeType GivenLabelVersion = 1; // changes when GivenLabels is copied or dropped
+  /// Smoothed fractions set aside while the scene's fractions are rebuilt.
+  std::map<int, vtkVolumeCutRayScene::FractionVolume> SmoothedSetAside;
+  vtkTypeInt64 LabelSmoothings = 0;
   std::vector<CutEntry> Cuts;
   std::vector<int> ActiveCuts; // indices into Cuts of the scene's cut fields
   vtkSmartPointer<vtkPlaneCollection> Planes;
@@ -280,6 +288,12 @@ int vtkVolumeCutRayCaster::GetNumberOfSegmentAppearances() const
 }
 
 //------------------------------------------------------------------------------
+vtkTypeInt64 vtkVolumeCutRayCaster::GetNumberOfLabelSmoothings() const
+{
+  return this->Impl->LabelSmoothings;
+}
+
+//------------------------------------------------------------------------------
 void vtkVolumeCutRayCaster::AddCutField(vtkVolumeCutField* field)
 {
   if (!field)
@@ -441,6 +455,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     {
       impl.Scene.Labels.clear();
       impl.GivenLabels.clear();
+      ++impl.GivenLabelVersion;
       ++impl.LabelVersion;
       sceneChanged = true;
       impl.BlockTime = 0;
@@ -461,6 +476,7 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
     }
     impl.LabelCopyTime = std::max(labelMap->GetMTime(), labelScalars ? labelScalars->GetMTime() : 0);
     impl.LabelsResolved = false;
+    ++impl.GivenLabelVersion;
   }
   else if (sceneChanged)
   {
@@ -476,6 +492,10 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
   }
   if (fractionTime > impl.FractionCopyTime || impl.FractionInputs.size() != impl.CopiedFractionInputs || sceneChanged)
   {
+    for (size_t n = impl.GivenFractions; n < impl.Scene.Fractions.size(); ++n)
+    {
+      impl.SmoothedSetAside[impl.Scene.Fractions[n].Label] = std::move(impl.Scene.Fractions[n]);
+    }
     impl.Scene.Fractions.clear();
     impl.SmoothedLabels.clear();
     impl.CopiedFractionInputs = impl.FractionInputs.size();
@@ -559,23 +579,59 @@ bool vtkVolumeCutRayCaster::PrepareScene(bool& sceneChanged)
       }
     }
   }
-  if (smoothed != impl.SmoothedLabels || (!smoothed.empty() && (impl.SmoothedSigma != this->LabelSmoothing || impl.SmoothedLabelVersion != impl.LabelVersion)))
+  const bool smoothingSourceChanged = impl.SmoothedSigma != this->LabelSmoothing || impl.SmoothedLabelVersion != impl.GivenLabelVersion;
+  if (smoothed != impl.SmoothedLabels || (!smoothed.empty() && smoothingSourceChanged))
   {
+    // Those still valid are kept; only segments newly drawn by their shape
+    // are smoothed (each is a pass over its box, and a role change would
+    // otherwise smooth every shape segment again).
+    std::map<int, vtkVolumeCutRayScene::FractionVolume>& kept = impl.SmoothedSetAside;
+    for (size_t n = impl.GivenFractions; n < impl.Scene.Fractions.size(); ++n)
+    {
+      kept[impl.Scene.Fractions[n].Label] = std::move(impl.Scene.Fractions[n]);
+    }
     impl.Scene.Fractions.resize(impl.GivenFractions);
+    if (smoothingSourceChanged)
+    {
+      kept.clear();
+    }
+    std::vector<int> missing;
+    std::copy_if(smoothed.begin(), smoothed.end(), std::back_inserter(missing), [&](int label) { return !kept.count(label); });
     double spacing[3];
     for (int axis = 0; axis < 3; ++axis)
     {
       const double column[3] = { impl.Scene.IJKToWorld[axis], impl.Scene.IJKToWorld[4 + axis], impl.Scene.IJKToWorld[8 + axis] };
       spacing[axis] = vtkMath::Norm(column);
     }
-    vtkVolumeCutLabelSmoothing::Smooth(impl.Scene.Labels, impl.Scene.Dimensions, spacing, smoothed, this->LabelSmoothing,
-      this->MaximumNumberOfThreads, impl.Scene.Fractions);
+    std::vector<vtkVolumeCutRayScene::FractionVolume> made;
+    vtkVolumeCutLabelSmoothing::Smooth(impl.Scene.Labels, impl.Scene.Dimensions, spacing, missing, this->LabelSmoothing,
+      this->MaximumNumberOfThreads, made);
+    impl.LabelSmoothings += static_cast<vtkTypeInt64>(made.size());
+    for (vtkVolumeCutRayScene::FractionVolume& fraction : made)
+    {
+      kept[fraction.Label] = std::move(fraction);
+    }
+    // In label order, as if all were smoothed now; labels absent from the
+    // map have none. Those no longer drawn by their shape are dropped.
+    for (int label : smoothed)
+    {
+      auto found = kept.find(label);
+      if (found != kept.end())
+      {
+        impl.Scene.Fractions.push_back(std::move(found->second));
+      }
+    }
+    kept.clear();
     impl.SmoothedLabels = smoothed;
     impl.SmoothedSigma = this->LabelSmoothing;
+    impl.SmoothedLabelVersion = impl.GivenLabelVersion;
     ++impl.LabelVersion;
-    impl.SmoothedLabelVersion = impl.LabelVersion;
     impl.BlockTime = 0;
     sceneChanged = true;
+  }
+  else
+  {
+    impl.SmoothedSetAside.clear();
   }
 
   int fractionBlocks[3];

@@ -189,6 +189,15 @@ public:
   vtkGetMacro(LabelSmoothing, double);
   ///@}
 
+  /**
+   * How many smoothed fractions (one per segment drawn by its shape) were
+   * computed since this caster was made. A segment's smoothed fraction
+   * depends only on its own voxels and the smoothing, so changing another
+   * segment's appearance (a role change in the application) computes none
+   * again, and drawing one more segment by its shape computes one.
+   */
+  vtkTypeInt64 GetNumberOfLabelSmoothings() const;
+
   ///@{
   /**
    * Ambient occlusion, a depth cue that makes cavities read in a still

@@ -200,3 +200,24 @@ def test_a_stroke_draws_reduced_frames_and_the_full_image_once_it_ends(session):
     off_axis = math.hypot(near[0] / near[3] - pit[0], near[1] / near[3] - pit[1])
     z, _ = surface_z(view, 32, 32)
     assert z == pytest.approx(top - math.sqrt(2.5**2 - off_axis**2), abs=0.02)
+
+
+def test_a_role_change_that_changes_no_appearance_leaves_the_ray_caster_untouched(session):
+    """Protected and role-less segments look alike (their own shape): switching between them redraws nothing.
+
+    The displayable manager used to give the caster every appearance again on
+    any change of the node, which modified it: on the temporal bone the caster
+    then rebuilt its empty-space data (seconds) and drew the view again.
+    """
+    application, scene, volume, cut_node, view = session
+    logic = application.volume_cutting_logic
+    cortical, trabecular = logic.GetCorticalBoneSegmentID(), logic.GetTrabecularBoneSegmentID()
+    caster = view.volume_cut_displayable_manager.GetVolumeActor(cut_node).GetMapper().GetRayCaster()
+    cut_node.SetCuttableSegmentIDs([cortical])
+    cut_node.SetProtectedSegmentIDs([trabecular])
+    view.render()
+    before = caster.GetMTime()
+    cut_node.SetProtectedSegmentIDs([])  # trabecular bone: from protected to no role
+    assert caster.GetMTime() == before
+    cut_node.SetCuttableSegmentIDs([cortical, trabecular])  # a real appearance change still reaches it
+    assert caster.GetMTime() > before
