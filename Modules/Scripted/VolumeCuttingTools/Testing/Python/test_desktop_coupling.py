@@ -117,6 +117,8 @@ def test_coupled_the_trainees_tool_is_pulled_to_the_instructors_and_stop_detache
     seen = instructor.status()
     assert seen.distance_mm == pytest.approx(3.0, abs=0.05) and seen.force_N <= seen.device_limit_N
     assert "Coupled with the trainee at 127.0.0.1" in seen.text and "device limit 8.0 N" in seen.text
+    # The instructor's panel may not Drill meanwhile; the trainee's may (it does).
+    assert "does not drill" in instructor.refuses_drill() and trainee.refuses_drill() is None
 
     # The trainee's compliant hand gives way to its device's force: the tool node reaches the instructor's tool.
     hand = np.zeros(3)

@@ -54,6 +54,8 @@ ANY_ADDRESS = "0.0.0.0"
 PEER_RATE_HZ = 1000.0
 #: The packets/s are counted over this much of the latest polls (s).
 RATE_WINDOW_S = 1.0
+#: How often the panel polls the status (s).
+STATUS_PERIOD_S = 0.1
 #: The instructor's side says nobody answered after this long (s); it goes on waiting.
 ANSWER_WAIT_S = couplingoptions.DEFAULT_ANSWER_TIMEOUT_S
 
@@ -241,6 +243,13 @@ class DesktopCoupling:
         self.role, self.options, self.end = role, options, end
         self.peers = couplingoptions.PeerWatch(options, end)
         self._counts.clear()
+
+    def refuses_drill(self) -> str | None:
+        """Why the panel's Drill may not start now (None: it may): the instructor's device guides, it does not drill."""
+        if self.running and self.role == INSTRUCTOR:
+            return ("this side is the instructor's: its device guides the trainee's tool and does not drill. Stop the "
+                    "coupling first")
+        return None
 
     def stop(self) -> CouplingSnapshot:
         """End this side; the trainee's Drill goes on uncoupled, every cut kept. Safe to call when not running."""
