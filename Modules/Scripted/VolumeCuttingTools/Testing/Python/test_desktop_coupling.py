@@ -18,6 +18,7 @@ import pytest
 import slicer
 import vtk
 
+from VolumeCuttingLib.collaboration import desktopcoupling
 from VolumeCuttingLib.collaboration.desktopcoupling import INSTRUCTOR, OFF, TRAINEE, CouplingInputError, DesktopCoupling
 from VolumeCuttingLib.config import inputdevices, toolconfig
 from VolumeCuttingLib.config.hapticdrilling import HapticDrilling
@@ -214,6 +215,23 @@ def test_bad_input_is_refused_with_a_message_and_nothing_changes(desk):
     with pytest.raises(CouplingInputError, match="runs already"):
         coupling.start(TRAINEE, port=0, drilling=drilling)
     assert coupling.running and drilling.coupling is coupling.end
+
+
+def test_an_instructor_nobody_answers_keeps_waiting_and_says_what_to_check(desk, monkeypatch):
+    monkeypatch.setattr(desktopcoupling, "ANSWER_WAIT_S", 0.2)
+    silent = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    silent.bind(("127.0.0.1", 0))  # a port that takes the packets and never answers
+    try:
+        instructor = side(desk)
+        port = silent.getsockname()[1]
+        first = start_instructor(desk, instructor, port)
+        assert first.state == "waiting" and f"Waiting for the trainee at 127.0.0.1:{port}" in first.text
+        assert "Nobody answered" not in first.text
+        assert wait_for(lambda: "Nobody answered" in instructor.status().text)
+        later = instructor.status()
+        assert later.state == "waiting" and later.running and f"UDP port {port} is open" in later.text
+    finally:
+        silent.close()
 
 
 def test_the_drill_stopped_ends_the_trainees_coupling(desk):

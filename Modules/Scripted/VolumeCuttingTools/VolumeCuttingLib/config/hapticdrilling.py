@@ -9,8 +9,9 @@ the mouse, attaches ``vtkVirtualHapticDeviceMouseDriver`` to the 3D view so
 that the pointer moves the drill, the wheel pushes it in depth and the left
 button runs it. ``update`` is called at display rate (the desktop widget's
 timer, or a web view's frame); ``stop`` ends the session and gives the mouse
-back to the camera. Qt-free: the desktop widget only connects a button and a
-timer to it.
+back to the camera; ``restart`` starts it again as it was, with or without a
+force coupling (the instructor coupling: ``collaboration.desktopcoupling``).
+Qt-free: the desktop widget only connects a button and a timer to it.
 
 Anything that cannot start (no tool, a device that does not open, a Falcon
 without its firmware file, a foot switch chosen to move the drill) raises
