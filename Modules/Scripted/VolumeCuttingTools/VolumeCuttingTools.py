@@ -24,6 +24,7 @@ from slicer.ScriptedLoadableModule import (
 )
 from slicer.util import VTKObservationMixin
 
+from VolumeCuttingLib.collaboration import desktopcoupling
 from VolumeCuttingLib.config import hapticdrilling, inputdevices, toolconfig
 from VolumeCuttingLib.data import headct, phantom
 from VolumeCuttingLib.feedback import desktopfeedback
@@ -78,6 +79,10 @@ class VolumeCuttingToolsParameterNode:
     toolPower - fraction of the handpiece's maximum power.
     toolSpeed - revolutions (burrs, disk saws) or oscillations (blades) per minute.
     inputDevice - device_id of the device that drives the tool (toolconfig.list_devices()).
+    couplingRole - the instructor coupling's side: off, trainee (waits) or instructor (connects).
+    couplingPort - the UDP port the trainee's side waits on (0: any free port, shown once started).
+    couplingFromOtherMachines - the trainee's side can be reached from other machines (else this one only).
+    couplingPeer - HOST:PORT of the trainee's side the instructor's connects to.
     """
 
     phantomSize: Annotated[int, WithinRange(32, 256)] = 128
@@ -97,6 +102,10 @@ class VolumeCuttingToolsParameterNode:
     toolPower: Annotated[float, WithinRange(*toolconfig.RANGES["power"])] = DEFAULT_TOOL.power
     toolSpeed: Annotated[float, WithinRange(*toolconfig.RANGES["speed"])] = DEFAULT_TOOL.speed
     inputDevice: str = "mouse"
+    couplingRole: Annotated[str, Choice(list(desktopcoupling.ROLES))] = desktopcoupling.OFF
+    couplingPort: Annotated[int, WithinRange(0, 65535)] = 47000
+    couplingFromOtherMachines: bool = False
+    couplingPeer: str = "127.0.0.1:47000"
 
 
 #
@@ -114,6 +123,8 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self._drilling = None
         self._drillTimer = None
         self._feedback = None
+        self._coupling = desktopcoupling.DesktopCoupling()
+        self._couplingTimer = None
 
     def setup(self) -> None:
         ScriptedLoadableModuleWidget.setup(self)
@@ -137,6 +148,14 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         self.ui.drillButton.connect("toggled(bool)", self.onDrillToggled)
         self.ui.drillSoundCheckBox.connect("toggled(bool)", self.onDrillSoundToggled)
         self.ui.soundVolumeSliderWidget.connect("valueChanged(double)", self.onSoundVolumeChanged)
+        for radio in self._couplingRadios().values():
+            radio.connect("toggled(bool)", self.onCouplingRoleToggled)
+        self.ui.couplingButton.connect("toggled(bool)", self.onCouplingToggled)
+        # The status line follows the coupling (the peer joining, going, refused) on a timer of its own: the
+        # instructor's side runs without the Drill's.
+        self._couplingTimer = qt.QTimer()
+        self._couplingTimer.setInterval(round(desktopcoupling.STATUS_PERIOD_S * 1000))
+        self._couplingTimer.connect("timeout()", self.onCouplingTimer)
         # The scene follows the haptic thread at display rate; the monitor's meter and the drill sound's
         # parameters follow at the same rate (at least the 50 Hz the sound needs).
         self._drillTimer = qt.QTimer()
@@ -147,6 +166,7 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
 
     def cleanup(self) -> None:
         self._stopDrilling()
+        self._stopCoupling()
         self.removeObservers()
 
     def enter(self) -> None:
@@ -160,6 +180,7 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
 
     def onSceneStartClose(self, caller, event) -> None:
         self._stopDrilling()
+        self._stopCoupling()
         self.setParameterNode(None)
 
     def onSceneEndClose(self, caller, event) -> None:
@@ -189,6 +210,11 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         p = self._parameterNode
         self.ui.applyToolButton.enabled = p is not None and p.toolNode is not None
         self.ui.followRolesButton.enabled = p is not None and p.toolNode is not None
+        if p is not None:
+            radio = self._couplingRadios()[p.couplingRole]
+            wasBlocked = radio.blockSignals(True)
+            radio.checked = True
+            radio.blockSignals(wasBlocked)
         self._updateSensibilityTable()
 
     def _updateSensibilityTable(self) -> None:
@@ -279,6 +305,9 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
         view = slicer.app.layoutManager().threeDWidget(0).threeDView()
         renderer = view.renderWindow().GetRenderers().GetFirstRenderer()
         try:
+            refusal = self._coupling.refuses_drill()
+            if refusal:
+                raise hapticdrilling.HapticDrillingError(refusal)
             self._drilling = self.logic.startDrilling(
                 self._parameterNode, renderer, view.interactor(),
                 footSwitch=self.ui.footSwitchComboBox.currentData or None,
@@ -329,6 +358,56 @@ class VolumeCuttingToolsWidget(ScriptedLoadableModuleWidget, VTKObservationMixin
             levelItem = qt.QTableWidgetItem(row["level"])
             levelItem.setBackground(qt.QBrush(qt.QColor(row["colour"])))
             table.setItem(index, 2, levelItem)
+
+    def _couplingRadios(self) -> dict:
+        return {desktopcoupling.OFF: self.ui.couplingOffRadioButton, desktopcoupling.TRAINEE: self.ui.couplingTraineeRadioButton,
+                desktopcoupling.INSTRUCTOR: self.ui.couplingInstructorRadioButton}
+
+    def onCouplingRoleToggled(self, checked: bool) -> None:
+        if checked and self._parameterNode:
+            self._parameterNode.couplingRole = next(role for role, radio in self._couplingRadios().items() if radio.checked)
+
+    def onCouplingToggled(self, checked: bool) -> None:
+        if not checked:
+            self._stopCoupling()
+            return
+        p = self._parameterNode
+        view = slicer.app.layoutManager().threeDWidget(0).threeDView()
+        try:
+            snapshot = self._coupling.start(
+                p.couplingRole, port=p.couplingPort, peer=p.couplingPeer, from_other_machines=p.couplingFromOtherMachines,
+                drilling=self._drilling, volume=self.logic.couplingVolume(p), device=p.inputDevice,
+                renderer=view.renderWindow().GetRenderers().GetFirstRenderer(), interactor=view.interactor(),
+                falcon_firmware=self.ui.falconFirmwarePathLineEdit.currentPath or None, tool_node=p.toolNode)
+        except desktopcoupling.CouplingInputError as error:
+            self._showCoupling(self._coupling.status())
+            self.ui.couplingStatusLabel.text = f"Not started: {error}."
+            return
+        self._showCoupling(snapshot)
+        self._couplingTimer.start()
+
+    def onCouplingTimer(self) -> None:
+        self._showCoupling(self._coupling.status())
+
+    def _showCoupling(self, snapshot) -> None:
+        """The status line, the button and the fields (locked while the coupling runs)."""
+        self.ui.couplingStatusLabel.text = snapshot.text
+        if not snapshot.running and self._couplingTimer is not None:
+            self._couplingTimer.stop()
+        wasBlocked = self.ui.couplingButton.blockSignals(True)
+        self.ui.couplingButton.checked = snapshot.running
+        self.ui.couplingButton.text = "Stop coupling" if snapshot.running else "Start coupling"
+        self.ui.couplingButton.blockSignals(wasBlocked)
+        for widget in (*self._couplingRadios().values(), self.ui.couplingPortSpinBox, self.ui.couplingPeerLineEdit,
+                       self.ui.couplingFromOtherMachinesCheckBox):
+            widget.enabled = not snapshot.running
+
+    def _stopCoupling(self) -> None:
+        """Stop this side (the trainee's Drill goes on uncoupled, every cut kept)."""
+        if hasattr(self, "ui"):
+            self._showCoupling(self._coupling.stop())
+        else:
+            self._coupling.stop()
 
     def _stopDrilling(self) -> None:
         if self._drillTimer is not None:
@@ -410,6 +489,12 @@ class VolumeCuttingToolsLogic(ScriptedLoadableModuleLogic):
         drilling.start(parameterNode.cutNode, parameterNode.inputDevice, renderer, interactor,
                        foot_switch=footSwitch, falcon_firmware=falconFirmware)
         return drilling
+
+    def couplingVolume(self, parameterNode):
+        """The scan both sides of the instructor coupling must load: the cut session's CT, else the chosen CT."""
+        p = parameterNode
+        cutVolume = p.cutNode.GetAnatomyVolumeNode() if p.cutNode is not None else None
+        return cutVolume if cutVolume is not None else p.anatomyVolume
 
     def startFeedback(self, parameterNode, sound: bool = True, volume: float = 1.0) -> desktopfeedback.DesktopFeedback:
         """The nerve monitor's meter and the drill sound for the parameter node's cut session (silent, with a

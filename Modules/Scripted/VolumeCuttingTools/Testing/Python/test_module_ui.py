@@ -5,7 +5,7 @@ it are made statically: the module compiles, every ``SlicerParameterName`` in
 the .ui is a parameter of the parameter node, every ``self.ui.<name>``
 the widget uses is a widget of the .ui, and what it asks of the Qt-free
 controllers (the nerve monitor's meter and drill sound, the drilling
-session) exists there.
+session, the instructor coupling and its status snapshot) exists there.
 """
 
 import ast
@@ -48,7 +48,8 @@ def test_ui_parameters_exist_in_the_parameter_node():
     assert set(bound.values()) <= parameters, set(bound.values()) - parameters
     # Each parameter is shown by one widget at most.
     assert len(set(bound.values())) == len(bound)
-    for parameter in ("toolPreset", "toolShape", "burrType", "toolDiameter", "toolPower", "toolSpeed", "cutNode", "toolNode"):
+    for parameter in ("toolPreset", "toolShape", "burrType", "toolDiameter", "toolPower", "toolSpeed", "cutNode", "toolNode",
+                      "couplingPort", "couplingPeer", "couplingFromOtherMachines"):
         assert parameter in bound.values()
 
 
@@ -70,13 +71,50 @@ def attributes_used_on(owner: str) -> set:
     return used
 
 
+def test_the_instructor_coupling_group_is_in_the_ui():
+    """Off / trainee (port, from other machines) / instructor (HOST:PORT), Start/Stop and the status line."""
+    widgets = ui_widgets()
+    expected = {
+        "couplingGroupBox": ("QGroupBox", None),
+        "couplingOffRadioButton": ("QRadioButton", None),
+        "couplingTraineeRadioButton": ("QRadioButton", None),
+        "couplingInstructorRadioButton": ("QRadioButton", None),
+        "couplingPortSpinBox": ("QSpinBox", "couplingPort"),
+        "couplingFromOtherMachinesCheckBox": ("QCheckBox", "couplingFromOtherMachines"),
+        "couplingPeerLineEdit": ("QLineEdit", "couplingPeer"),
+        "couplingButton": ("QPushButton", None),
+        "couplingStatusLabel": ("QLabel", None),
+    }
+    assert {name: widgets.get(name) for name in expected} == expected
+    # In the haptic (tool) section, below the Drill button.
+    tool_section = next(w for w in ElementTree.parse(UI_FILE).getroot().iter("widget") if w.get("name") == "toolCollapsibleButton")
+    inside = {w.get("name") for w in tool_section.iter("widget")}
+    assert set(expected) <= inside and "drillButton" in inside
+
+
+def test_the_coupling_roles_are_the_controllers():
+    """The parameter node's roles are the controller's, one radio button each."""
+    from VolumeCuttingLib.collaboration import desktopcoupling
+
+    source = MODULE_FILE.read_text()
+    assert "Choice(list(desktopcoupling.ROLES))" in source
+    assert desktopcoupling.ROLES == (desktopcoupling.OFF, desktopcoupling.TRAINEE, desktopcoupling.INSTRUCTOR)
+    for role, radio in (("OFF", "couplingOffRadioButton"), ("TRAINEE", "couplingTraineeRadioButton"),
+                        ("INSTRUCTOR", "couplingInstructorRadioButton")):
+        assert f"desktopcoupling.{role}: self.ui.{radio}" in source, role
+
+
 def test_the_widget_asks_the_desktop_controllers_only_for_what_they_have():
+    from VolumeCuttingLib.collaboration import desktopcoupling
     from VolumeCuttingLib.config import hapticdrilling
     from VolumeCuttingLib.feedback import desktopfeedback
 
     feedback = desktopfeedback.DesktopFeedback(logic=None)
     for owner, provided in (("_feedback", set(dir(feedback))), ("desktopfeedback", set(dir(desktopfeedback))),
-                            ("_drilling", set(dir(hapticdrilling.HapticDrilling(logic=None))))):
+                            ("_drilling", set(dir(hapticdrilling.HapticDrilling(logic=None)))),
+                            ("_coupling", set(dir(desktopcoupling.DesktopCoupling()))),
+                            ("desktopcoupling", set(dir(desktopcoupling))),
+                            ("snapshot", set(dir(desktopcoupling.CouplingSnapshot())))):
         used = attributes_used_on(owner)
         assert used, f"the widget uses nothing of {owner}: the check would prove nothing"
         assert used <= provided, (owner, used - provided)

@@ -95,13 +95,18 @@ def _numeric_host(text: str, what: str) -> str:
     return infos[0][4][0]
 
 
-def parse_peer(text: str) -> tuple[str, int]:
-    """``HOST:PORT`` as (numeric IPv4 address, port); ValueError naming what is wrong."""
+def parse_peer(text: str, what: str = "--couple-to") -> tuple[str, int]:
+    """``HOST:PORT`` as (numeric IPv4 address, port); ValueError naming ``what`` (the option or field) and the fault."""
     host, separator, port_text = str(text).strip().rpartition(":")
     if not separator or not host or not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
-        raise ValueError(f"--couple-to {text!r}: expected HOST:PORT with a port from 1 to 65535, "
-                         "such as 192.168.1.20:47000 (the port the trainee's side printed)")
-    return _numeric_host(host, f"--couple-to {text!r}"), int(port_text)
+        raise ValueError(f"{what} {text!r}: expected HOST:PORT with a port from 1 to 65535, "
+                         "such as 192.168.1.20:47000 (the port the trainee's side shows)")
+    return _numeric_host(host, f"{what} {text!r}"), int(port_text)
+
+
+def joining_host(peer_host: str) -> str:
+    """Where the joining side binds by default: this machine only for a peer on it, else every interface."""
+    return LOOPBACK if ipaddress.IPv4Address(peer_host).is_loopback else "0.0.0.0"
 
 
 def options_from_arguments(args) -> CouplingOptions | None:
@@ -121,7 +126,7 @@ def options_from_arguments(args) -> CouplingOptions | None:
         return CouplingOptions(TRAINEE, listen, host=host, stiffness=stiffness, answer_timeout_s=wait)
     peer_host, port = parse_peer(to)
     loopback = ipaddress.IPv4Address(peer_host).is_loopback
-    host = _numeric_host(args.couple_host or (LOOPBACK if loopback else "0.0.0.0"), "--couple-host")
+    host = _numeric_host(args.couple_host or joining_host(peer_host), "--couple-host")
     if loopback != ipaddress.IPv4Address(host).is_loopback and host != "0.0.0.0":
         raise ValueError(f"--couple-host {host} cannot reach the trainee at {peer_host}: leave --couple-host out")
     return CouplingOptions(INSTRUCTOR, port, peer_host=peer_host, host=host, stiffness=stiffness, answer_timeout_s=wait)

@@ -9,8 +9,9 @@ the mouse, attaches ``vtkVirtualHapticDeviceMouseDriver`` to the 3D view so
 that the pointer moves the drill, the wheel pushes it in depth and the left
 button runs it. ``update`` is called at display rate (the desktop widget's
 timer, or a web view's frame); ``stop`` ends the session and gives the mouse
-back to the camera. Qt-free: the desktop widget only connects a button and a
-timer to it.
+back to the camera; ``restart`` starts it again as it was, with or without a
+force coupling (the instructor coupling: ``collaboration.desktopcoupling``).
+Qt-free: the desktop widget only connects a button and a timer to it.
 
 Anything that cannot start (no tool, a device that does not open, a Falcon
 without its firmware file, a foot switch chosen to move the drill) raises
@@ -79,6 +80,8 @@ class HapticDrilling:
         self.foot_switch = None
         self.mouse_driver = None
         self.coupling = None
+        #: How the session was last started (restart starts it again so).
+        self._started_with = None
 
     @property
     def running(self) -> bool:
@@ -109,7 +112,7 @@ class HapticDrilling:
         chosen = resolve_device(device)
         collector = _ErrorCollector()
         try:
-            self.device = self._make_device(chosen, renderer, interactor, falcon_firmware)
+            self.device = make_device(chosen, renderer, interactor, falcon_firmware)
             self.foot_switch = self._make_foot_switch(foot_switch) if foot_switch is not None else None
             session = slicer.vtkSlicerVolumeCuttingHapticSession()
             session.SetLogic(self.logic)
@@ -129,12 +132,36 @@ class HapticDrilling:
                 raise HapticDrillingError(collector.reason(f"the drilling session with {chosen.name} could not start"))
             self.session = session
             if chosen.kind == MOUSE:
+                # The tool stays where it is until the mouse moves: a virtual device without a pose yet would put it
+                # at the scene's origin at the next update (and a restart would make it jump there).
+                self.device.SetPose([0.0, 0.0, 0.0], 0)
                 self._attach_mouse(renderer, interactor)
+            self._started_with = dict(cut_node=cut_node, device=chosen, renderer=renderer, interactor=interactor,
+                                      foot_switch=foot_switch, falcon_firmware=falcon_firmware, device_scale=device_scale)
         except BaseException:
             self._release()
             raise
         finally:
             collector.release()
+
+    def restart(self, coupling=None) -> None:
+        """Stop and start again as last started, now with ``coupling`` (None: uncoupled): a coupling can only be
+        attached to a stopped loop. The cut stays; the device's centre is placed where the tool is now.
+
+        When the session cannot start with ``coupling`` (its port is in use), it starts again without it, so that
+        the trainee goes on drilling, and HapticDrillingError says why.
+        """
+        if not self.running or self._started_with is None:
+            raise HapticDrillingError("no drilling session is running: press Drill first")
+        arguments = self._started_with
+        self._release()
+        try:
+            self.start(**arguments, coupling=coupling)
+        except HapticDrillingError:
+            if coupling is None:
+                raise
+            self.start(**arguments)
+            raise
 
     def update(self) -> int:
         """At display rate: moves the tool node where the haptic thread put it; the strokes cut since the last call."""
@@ -163,30 +190,6 @@ class HapticDrilling:
         self.foot_switch = None
 
     @staticmethod
-    def _make_device(chosen: InputDevice, renderer, interactor, falcon_firmware):
-        if chosen.kind == MOUSE:
-            if renderer is None or interactor is None:
-                raise HapticDrillingError("the mouse drills in a 3D view: no 3D view was given")
-            return slicer.vtkVirtualHapticDevice()
-        if chosen.kind == HAPTIC:
-            if not falcon_firmware or not Path(falcon_firmware).is_file():
-                raise HapticDrillingError(
-                    f"{chosen.name} needs its firmware file, which is not shipped: choose the file your device came with"
-                    + (f" ({falcon_firmware} is not a file)" if falcon_firmware else ""))
-            falcon = slicer.vtkNovintFalconDevice()
-            falcon.SetFirmwareFileName(str(falcon_firmware))
-            return falcon
-        if chosen.kind == SIX_DOF:
-            spacemouse = slicer.vtkSpaceMouseDevice()
-            spacemouse.GetConnection().SetDevicePath(chosen.device_id)
-            return spacemouse
-        if chosen.kind == FOOT_SWITCH:
-            raise HapticDrillingError(
-                f"{chosen.name} is a foot switch: it runs the drill but cannot move it; choose the mouse or a device that "
-                "moves the tool, and the foot switch as its drill switch")
-        raise HapticDrillingError(f"{chosen.name} cannot drive the drill")
-
-    @staticmethod
     def _make_foot_switch(foot_switch):
         chosen = resolve_device(foot_switch)
         if chosen.kind != FOOT_SWITCH:
@@ -198,13 +201,45 @@ class HapticDrilling:
     def _attach_mouse(self, renderer, interactor) -> None:
         device_to_world = vtk.vtkMatrix4x4()
         self.session.GetLoop().GetDeviceToRAS(device_to_world)
-        world_to_device = vtk.vtkMatrix4x4()
-        vtk.vtkMatrix4x4.Invert(device_to_world, world_to_device)
-        driver = slicer.vtkVirtualHapticDeviceMouseDriver()
-        if not driver.SetWorldToDevice(world_to_device):
-            raise HapticDrillingError("the device's frame in the scene cannot be inverted")
-        driver.SetInteractor(interactor)
-        driver.SetDefaultRenderer(renderer)
-        driver.SetDevice(self.device)
-        driver.SetEnabled(1)
-        self.mouse_driver = driver
+        self.mouse_driver = attach_mouse_driver(self.device, device_to_world, renderer, interactor)
+
+
+def make_device(chosen: InputDevice, renderer=None, interactor=None, falcon_firmware=None):
+    """The haptic device for a listed device that moves the tool, not opened yet (HapticDrillingError when it cannot
+    be: a foot switch, a Falcon without its firmware file, the mouse without a 3D view)."""
+    if chosen.kind == MOUSE:
+        if renderer is None or interactor is None:
+            raise HapticDrillingError("the mouse drills in a 3D view: no 3D view was given")
+        return slicer.vtkVirtualHapticDevice()
+    if chosen.kind == HAPTIC:
+        if not falcon_firmware or not Path(falcon_firmware).is_file():
+            raise HapticDrillingError(
+                f"{chosen.name} needs its firmware file, which is not shipped: choose the file your device came with"
+                + (f" ({falcon_firmware} is not a file)" if falcon_firmware else ""))
+        falcon = slicer.vtkNovintFalconDevice()
+        falcon.SetFirmwareFileName(str(falcon_firmware))
+        return falcon
+    if chosen.kind == SIX_DOF:
+        spacemouse = slicer.vtkSpaceMouseDevice()
+        spacemouse.GetConnection().SetDevicePath(chosen.device_id)
+        return spacemouse
+    if chosen.kind == FOOT_SWITCH:
+        raise HapticDrillingError(
+            f"{chosen.name} is a foot switch: it runs the drill but cannot move it; choose the mouse or a device that "
+            "moves the tool, and the foot switch as its drill switch")
+    raise HapticDrillingError(f"{chosen.name} cannot drive the drill")
+
+
+def attach_mouse_driver(device, device_to_world, renderer, interactor):
+    """Let the mouse in the 3D view move ``device`` (a vtkVirtualHapticDevice) placed in the scene by
+    ``device_to_world``; the enabled driver (``SetEnabled(0)`` gives the mouse back to the camera)."""
+    world_to_device = vtk.vtkMatrix4x4()
+    vtk.vtkMatrix4x4.Invert(device_to_world, world_to_device)
+    driver = slicer.vtkVirtualHapticDeviceMouseDriver()
+    if not driver.SetWorldToDevice(world_to_device):
+        raise HapticDrillingError("the device's frame in the scene cannot be inverted")
+    driver.SetInteractor(interactor)
+    driver.SetDefaultRenderer(renderer)
+    driver.SetDevice(device)
+    driver.SetEnabled(1)
+    return driver
