@@ -12,6 +12,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
+#include "vtkVolumeCutThreadClock.h"
 #include "vtkVolumeCutTool.h"
 
 #include <algorithm>
@@ -20,12 +21,6 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
-
-#if defined(_WIN32)
-#include <windows.h>
-#else
-#include <ctime>
-#endif
 
 vtkStandardNewMacro(vtkVolumeCutNerveMonitor);
 
@@ -97,24 +92,6 @@ void SampleToolSurface(vtkVolumeCutTool* tool, double step, std::vector<double>&
       }
     }
   }
-}
-
-/// Processor time this thread has used (us): what a measurement costs, whether or not the thread was preempted meanwhile.
-double ThreadProcessorMicroseconds()
-{
-#if defined(_WIN32)
-  FILETIME creation, exit, kernel, user;
-  if (!GetThreadTimes(GetCurrentThread(), &creation, &exit, &kernel, &user))
-  {
-    return 0.0;
-  }
-  const auto hundreds = [](const FILETIME& time) { return (static_cast<unsigned long long>(time.dwHighDateTime) << 32) | time.dwLowDateTime; };
-  return 0.1 * static_cast<double>(hundreds(kernel) + hundreds(user));
-#else
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
-#endif
 }
 
 /// Scan one image's voxels of a value inside a box of anatomy voxels.
@@ -735,13 +712,13 @@ bool vtkVolumeCutNerveMonitor::MeasureAlong(
   {
     double centre[3];
     centres->GetPoint(n, centre);
-    const double processorStart = processorMicroseconds ? ThreadProcessorMicroseconds() : 0.0;
+    const double processorStart = processorMicroseconds ? vtkVolumeCutThreadClock::ProcessorMicroseconds() : 0.0;
     const auto start = std::chrono::steady_clock::now();
     this->Measure(centre, radius, readings.data(), static_cast<int>(readings.size()));
     const auto end = std::chrono::steady_clock::now();
     if (processorMicroseconds)
     {
-      processorMicroseconds->SetValue(n, ThreadProcessorMicroseconds() - processorStart);
+      processorMicroseconds->SetValue(n, vtkVolumeCutThreadClock::ProcessorMicroseconds() - processorStart);
     }
     for (int index = 0; index < std::max(structures, 1); ++index)
     {
