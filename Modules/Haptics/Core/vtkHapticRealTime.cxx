@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "vtkHapticRealTime.h"
 
+#include "vtkVolumeCutThreadClock.h"
+
 #include <cerrno>
 #include <system_error>
 #include <thread>
@@ -149,19 +151,7 @@ void vtkHapticRealTime::WaitUntil(Clock::time_point deadline, Clock::duration sp
 //------------------------------------------------------------------------------
 double vtkHapticRealTime::ThreadProcessorMicroseconds()
 {
-#if defined(_WIN32)
-  FILETIME creation, exit, kernel, user;
-  if (!GetThreadTimes(GetCurrentThread(), &creation, &exit, &kernel, &user))
-  {
-    return 0.0;
-  }
-  const auto hundreds = [](const FILETIME& time) { return (static_cast<unsigned long long>(time.dwHighDateTime) << 32) | time.dwLowDateTime; };
-  return 0.1 * static_cast<double>(hundreds(kernel) + hundreds(user));
-#else
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return 1e6 * static_cast<double>(now.tv_sec) + 1e-3 * static_cast<double>(now.tv_nsec);
-#endif
+  return vtkVolumeCutThreadClock::ProcessorMicroseconds();
 }
 
 //------------------------------------------------------------------------------

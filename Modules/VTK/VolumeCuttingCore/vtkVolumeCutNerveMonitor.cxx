@@ -12,6 +12,7 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkSmartPointer.h"
+#include "vtkVolumeCutThreadClock.h"
 #include "vtkVolumeCutTool.h"
 
 #include <algorithm>
@@ -686,7 +687,8 @@ int vtkVolumeCutNerveMonitor::Measure(const double centre[3], double radius, Rea
 }
 
 //------------------------------------------------------------------------------
-bool vtkVolumeCutNerveMonitor::MeasureAlong(vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds)
+bool vtkVolumeCutNerveMonitor::MeasureAlong(
+  vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds, vtkDoubleArray* processorMicroseconds)
 {
   if (!centres || !distances)
   {
@@ -697,19 +699,27 @@ bool vtkVolumeCutNerveMonitor::MeasureAlong(vtkPoints* centres, double radius, v
   const vtkIdType count = centres->GetNumberOfPoints();
   distances->SetNumberOfComponents(std::max(structures, 1));
   distances->SetNumberOfTuples(count);
-  if (microseconds)
+  for (vtkDoubleArray* durations : { microseconds, processorMicroseconds })
   {
-    microseconds->SetNumberOfComponents(1);
-    microseconds->SetNumberOfTuples(count);
+    if (durations)
+    {
+      durations->SetNumberOfComponents(1);
+      durations->SetNumberOfTuples(count);
+    }
   }
   std::vector<Reading> readings(std::max(structures, 1));
   for (vtkIdType n = 0; n < count; ++n)
   {
     double centre[3];
     centres->GetPoint(n, centre);
+    const double processorStart = processorMicroseconds ? vtkVolumeCutThreadClock::ProcessorMicroseconds() : 0.0;
     const auto start = std::chrono::steady_clock::now();
     this->Measure(centre, radius, readings.data(), static_cast<int>(readings.size()));
     const auto end = std::chrono::steady_clock::now();
+    if (processorMicroseconds)
+    {
+      processorMicroseconds->SetValue(n, vtkVolumeCutThreadClock::ProcessorMicroseconds() - processorStart);
+    }
     for (int index = 0; index < std::max(structures, 1); ++index)
     {
       distances->SetTypedComponent(n, index, index < structures ? readings[index].Distance : std::numeric_limits<double>::quiet_NaN());

@@ -228,10 +228,14 @@ public:
    * Measure for a burr of radius at each of centres (RAS), as Measure: the
    * distances (one tuple of GetNumberOfStructures components per centre)
    * into distances and, unless nullptr, each measurement's duration (us)
-   * into microseconds: a trajectory's readings, and the per-tick cost from
-   * Python. False (and an error) without centres or distances.
+   * into microseconds and the processor time this thread spent in it (us)
+   * into processorMicroseconds: a trajectory's readings, and the per-tick
+   * cost from Python. A duration far above its processor time is time the
+   * thread was not running (preempted), not the measurement's cost. False
+   * (and an error) without centres or distances.
    */
-  bool MeasureAlong(vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds);
+  bool MeasureAlong(vtkPoints* centres, double radius, vtkDoubleArray* distances, vtkDoubleArray* microseconds,
+    vtkDoubleArray* processorMicroseconds = nullptr);
 
   /**
    * Points on tool's surface (its frame) where MeasureTool reads, made on

@@ -9,7 +9,8 @@ axis, rasterised at 0.15 mm (the temporal-bone scale); burrs of 0.5, 1 and
 smoothed surface's distance (``GetDistanceAt`` less the radius) against the
 exact one to the cylinder and, baseline, the distance to the label's voxel
 cubes (what the reading was when it measured to the shield), measured on the
-same burrs in the same process. (2) Clinical voxels: a ball of 3 mm radius
+same burrs in the same process; the same on thick slices (0.15 x 0.15 x 0.3
+and 0.2 x 0.2 x 0.5 mm), the axis oblique and nearly along the slices. (2) Clinical voxels: a ball of 3 mm radius
 on 1 x 1 x 1.5 mm voxels with the grid's direction flipped, monitored
 without smoothing (the shield is then the voxel cubes, known exactly): burrs
 placed 0 to 2 mm from the cubes, the reading against that distance, and how
@@ -23,7 +24,18 @@ call: all of them, as the logic's worker builds them; and the longest one
 structure took); one query of all 10 for a burr of 2 mm at 2000 positions
 around the middle of the case, each timed in C++ (p50, p99, max), against
 the brute-force distance from the burr to the 10 structures' surface voxels
-(numpy, the baseline) on the first positions. One core, this machine.
+(numpy, the baseline) on the first positions. One core, this machine. Each
+query's wall time includes whatever the system did meanwhile; the querying
+thread's processor time beside it tells a slow query from a preempted thread
+(a wall time of milliseconds with microseconds of processor time): its p99
+and max, the queries that lost more than the tick's 20 us off the processor,
+and an empty monitor's query as the floor the machine sets (a timer
+interrupt's handler is counted in the processor time of the thread it
+interrupts). The first query after the build, the first pass over the positions (every brick
+cold in the caches) and a burr's path (10 um per tick, as in a haptic loop).
+Where the system allows it, the pass again on this thread at the haptic
+loop's real-time priority (SCHED_FIFO 80, as vtkHapticLoop asks for its
+thread): what a haptic tick sees.
 
 ``monitor_measurements(repeats)`` returns the harness's measurements; the
 lead combines them with the sound's figures into the area ``feedback``.
@@ -31,6 +43,7 @@ lead combines them with the sound's figures into the area ``feedback``.
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -44,12 +57,17 @@ from .harness import machine_description, measurement
 CYLINDER_RADIUS = 0.7
 CYLINDER_SPACING = 0.15
 CYLINDER_EXTENT = 16.0
+ANISOTROPIC_SPACINGS = ((0.15, 0.15, 0.3), (0.2, 0.2, 0.5))
+CYLINDER_AXES = (("oblique", (0.7, -0.4, 0.59)), ("nearly along the slices", (1.0, 0.1, 0.05)))
 BURR_RADII = (0.5, 1.0, 2.0)
 DISTANCES = (0.05, 0.3, 1.0, 1.5, 2.5, 3.5)
 MONITORED = 10
 QUERIES = 2000
 BRUTE_FORCE_QUERIES = 40
 BURR = 2.0
+TICK_BUDGET_US = 20.0
+FLOOR_REPEATS = 4
+HAPTIC_PRIORITY = 80
 
 
 def _label_image(labels: np.ndarray):
@@ -79,23 +97,51 @@ def _voxel_cube_distance(centres_ras, voxels_ras, half):
     return np.array(result)
 
 
-def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
-    n = int(CYLINDER_EXTENT / CYLINDER_SPACING)
-    ijk_to_ras = np.diag([CYLINDER_SPACING] * 3 + [1.0])
-    centre = np.full(3, (n - 1) / 2 * CYLINDER_SPACING)
-    axis = np.array([0.7, -0.4, 0.59])
+def _query_times(monitor, centres) -> tuple[np.ndarray, np.ndarray]:
+    """Each query's wall time and the querying thread's processor time in it (us), for a burr of BURR at each centre."""
+    points = vtk.vtkPoints()
+    for centre in centres:
+        points.InsertNextPoint(*(float(v) for v in centre))
+    distances, microseconds, processor = vtk.vtkDoubleArray(), vtk.vtkDoubleArray(), vtk.vtkDoubleArray()
+    monitor.MeasureAlong(points, BURR, distances, microseconds, processor)
+    return numpy_support.vtk_to_numpy(microseconds).copy(), numpy_support.vtk_to_numpy(processor).copy()
+
+
+def _at_haptic_priority(run):
+    """run() on this thread at the haptic loop's real-time priority (SCHED_FIFO 80, vtkHapticLoop's default), then
+    back; None where the system refuses it."""
+    if not hasattr(os, "sched_setscheduler"):
+        return None
+    before, parameters = os.sched_getscheduler(0), os.sched_getparam(0)
+    try:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(HAPTIC_PRIORITY))
+    except OSError:
+        return None
+    try:
+        return run()
+    finally:
+        os.sched_setscheduler(0, before, parameters)
+
+
+def _cylinder_errors(spacing, axis, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Errors (mm) against the analytic cylinder nerve on a grid of spacing (mm per axis), its axis along axis: of the
+    smoothed surface's distance, and of the distance to the label's voxel cubes, for count burrs around its middle."""
+    spacing = np.asarray(spacing, dtype=float)
+    dims = (CYLINDER_EXTENT / spacing).astype(int)
+    ijk_to_ras = np.diag(list(spacing) + [1.0])
+    centre = (dims - 1) / 2 * spacing
+    axis = np.asarray(axis, dtype=float)
     axis /= np.linalg.norm(axis)
-    k, j, i = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
-    points = np.stack([i, j, k], axis=-1) * CYLINDER_SPACING - centre
+    k, j, i = np.meshgrid(*(np.arange(n) for n in dims[::-1]), indexing="ij")
+    points = np.stack([i, j, k], axis=-1) * spacing - centre
     radial = points - (points @ axis)[..., None] * axis
     labels = (np.linalg.norm(radial, axis=-1) <= CYLINDER_RADIUS).astype(np.uint16)
     monitor = slicer.vtkVolumeCutNerveMonitor()
-    monitor.SetGeometry([n, n, n], _matrix(ijk_to_ras))
+    monitor.SetGeometry([int(n) for n in dims], _matrix(ijk_to_ras))
     monitor.AddStructure("cylinder nerve", _label_image(labels), 1)
     monitor.Build()
 
     rng = np.random.default_rng(25)
-    count = 60 * max(1, repeats)
     centres, exact, radii = [], [], []
     for q in range(count):
         distance = DISTANCES[q % len(DISTANCES)]
@@ -110,17 +156,32 @@ def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
     for point, burr in zip(centres, radii):
         measured.append(monitor.GetDistanceAt(0, [float(v) for v in point]) - burr)
     error = np.abs(np.array(measured) - np.array(exact))
-    voxel_centres = np.argwhere(labels[:, :, :] > 0)[:, ::-1] * CYLINDER_SPACING
-    stairs = _voxel_cube_distance(np.array(centres), voxel_centres, CYLINDER_SPACING / 2) - np.array(radii)
-    stairs_error = np.abs(stairs - np.array(exact))
+    voxel_centres = np.argwhere(labels[:, :, :] > 0)[:, ::-1] * spacing
+    stairs = _voxel_cube_distance(np.array(centres), voxel_centres, spacing / 2) - np.array(radii)
+    return error, np.abs(stairs - np.array(exact))
+
+
+def _cylinder_accuracy(machine, repeats: int) -> list[dict]:
+    count = 60 * max(1, repeats)
+    error, stairs_error = _cylinder_errors([CYLINDER_SPACING] * 3, [0.7, -0.4, 0.59], count)
     where = (f"cylinder nerve r {CYLINDER_RADIUS} mm at {CYLINDER_SPACING} mm voxels, {count} burrs of 0.5-2 mm at 0.05-3.5 mm; "
              "the distance to the smoothed surface against the analytic cylinder")
-    return [
+    rows = [
         measurement(f"nerve monitor distance error, max ({where})", float(error.max()), "mm",
                     "distance to the label's voxel cubes, max error", float(stairs_error.max()), count, machine),
         measurement(f"nerve monitor distance error, mean ({where})", float(error.mean()), "mm",
                     "distance to the label's voxel cubes, mean error", float(stairs_error.mean()), count, machine),
     ]
+    # Thick slices: the smoothed surface is interpolated across them, and
+    # the issue's 0.05 mm is not met there yet (see Docs).
+    for spacing in ANISOTROPIC_SPACINGS:
+        for name, axis in CYLINDER_AXES:
+            error, stairs_error = _cylinder_errors(spacing, axis, count)
+            where = (f"cylinder nerve r {CYLINDER_RADIUS} mm, axis {name}, at {' x '.join(f'{v:g}' for v in spacing)} mm voxels, "
+                     f"{count} burrs of 0.5-2 mm at 0.05-3.5 mm")
+            rows.append(measurement(f"nerve monitor distance error, max ({where})", float(error.max()), "mm",
+                                    "distance to the label's voxel cubes, max error", float(stairs_error.max()), count, machine))
+    return rows
 
 
 def _clinical_voxel_accuracy(machine) -> list[dict]:
@@ -202,14 +263,18 @@ def _temporal_bone_cost(machine) -> list[dict]:
     rng = np.random.default_rng(10)
     middle = (ijk_to_ras @ np.array([(dims[0] - 1) / 2, (dims[1] - 1) / 2, (dims[2] - 1) / 2, 1.0]))[:3]
     centres = middle + rng.uniform(-12.0, 12.0, size=(QUERIES, 3))
-    points = vtk.vtkPoints()
-    for centre in centres:
-        points.InsertNextPoint(*centre)
-    distances = vtk.vtkDoubleArray()
-    microseconds = vtk.vtkDoubleArray()
-    monitor.MeasureAlong(points, BURR, distances, microseconds)  # warm
-    monitor.MeasureAlong(points, BURR, distances, microseconds)
-    times = numpy_support.vtk_to_numpy(microseconds)
+    first = _query_times(monitor, middle[None, :])
+    cold = _query_times(monitor, centres)
+    warm = _query_times(monitor, centres)
+    # The burr's path in a haptic loop: 10 um per tick, 20 mm through the middle.
+    path = _query_times(monitor, middle + np.linspace(-10.0, 10.0, QUERIES)[:, None] * np.array([1.0, 0.0, 0.0]))
+    # The machine's floor: the same loop over a monitor of no structure, for
+    # as long as the measured pass runs (an empty query takes ~0.05 us).
+    empty = slicer.vtkVolumeCutNerveMonitor()
+    empty.SetGeometry(list(dims), _matrix(ijk_to_ras))
+    floor = _query_times(empty, np.tile(centres, (FLOOR_REPEATS, 1)))
+    times, processor = warm
+    realtime = _at_haptic_priority(lambda: _query_times(monitor, centres))
 
     # Baseline: the exact distance to the structures' surface voxels, brute force.
     labels = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(dims[2], dims[1], dims[0])
@@ -230,18 +295,38 @@ def _temporal_bone_cost(machine) -> list[dict]:
     brute_p50 = float(np.percentile(brute, 50))
     where = f"{MONITORED} temporal-bone structures, 288^3 voxels of 0.15 mm, burr {BURR} mm"
     structures = len(chosen)
-    return [
+    rows = [
         measurement(f"nerve monitor query of all {structures} structures, p50 ({where})", float(np.percentile(times, 50)), "us",
                     "brute-force distance to their surface voxels (numpy), p50", brute_p50, QUERIES, machine),
         measurement(f"nerve monitor query of all {structures} structures, p99 ({where})", float(np.percentile(times, 99)), "us",
                     "brute-force distance to their surface voxels (numpy), p50", brute_p50, QUERIES, machine),
         measurement(f"nerve monitor query of all {structures} structures, max ({where})", float(times.max()), "us",
                     "brute-force distance to their surface voxels (numpy), max", float(np.max(brute)), QUERIES, machine),
+        measurement(f"nerve monitor query of all {structures} structures, processor time of the querying thread, p99 ({where})",
+                    float(np.percentile(processor, 99)), "us", "the tick's budget for it", TICK_BUDGET_US, QUERIES, machine),
+        measurement(f"nerve monitor query of all {structures} structures, processor time of the querying thread, max ({where})",
+                    float(processor.max()), "us", "an empty monitor's query, the machine's floor (timer interrupts), max",
+                    float(floor[1].max()), QUERIES * FLOOR_REPEATS, machine),
+        measurement(f"nerve monitor queries that lost more than {TICK_BUDGET_US:g} us off the processor (preempted: wall time less "
+                    f"processor time) ({where})", float(np.sum(times - processor > TICK_BUDGET_US)),
+                    "queries", f"queries above {TICK_BUDGET_US:g} us wall", float(np.sum(times > TICK_BUDGET_US)), QUERIES, machine),
+        measurement(f"nerve monitor first query after the build ({where})", float(first[0][0]), "us",
+                    "its processor time", float(first[1][0]), 1, machine),
+        measurement(f"nerve monitor first pass over {QUERIES} random positions (every brick cold), processor time, p99 ({where})",
+                    float(np.percentile(cold[1], 99)), "us", "the same, max", float(cold[1].max()), QUERIES, machine),
+        measurement(f"nerve monitor query along a burr path (10 um per tick), processor time, p99 ({where})",
+                    float(np.percentile(path[1], 99)), "us", "the same, max", float(path[1].max()), QUERIES, machine),
         measurement(f"nerve monitor fields build, first call: all {structures} structures ({where})", build_s, "s",
                     "the longest one structure took", monitor.GetLastMaximumStructureBuildTime(), 1, machine),
         measurement(f"nerve monitor fields memory ({where})", monitor.GetMemorySize() / 2**20, "MiB",
                     "the label image", image.GetActualMemorySize() / 1024.0, 1, machine),
     ]
+    if realtime is not None:
+        # Beside the other maxima.
+        rows.insert(3, measurement(
+            f"nerve monitor query of all {structures} structures at the haptic loop's priority (SCHED_FIFO {HAPTIC_PRIORITY}), max ({where})",
+            float(realtime[0].max()), "us", "its processor time, max", float(realtime[1].max()), QUERIES, machine))
+    return rows
 
 
 def monitor_measurements(repeats: int) -> list[dict]:
