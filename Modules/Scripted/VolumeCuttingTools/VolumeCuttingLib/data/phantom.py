@@ -41,9 +41,11 @@ position within the voxel. A box average of a few sub-samples instead takes
 only a few levels as a surface moves through a voxel, and even an exact box
 average leaves an edge too sharp for trilinear sampling: both showed the
 renderer's iso-surface as contour rings (issue 28, finding 10). The
-surface is taken as flat over the blur: structures thinner than a few sigma
-(the semicircular canals' lumen, the facial nerve) keep somewhat more
-contrast than a true convolution would leave them. Only voxels
+surface is taken as flat over the blur, so structures thinner than a few
+sigma keep more contrast than a true convolution would leave them: at
+128 x 128 x 96 and 0.4 x 0.4 x 0.5 mm the semicircular canals' fluid lumen
+(radius 0.37 mm) darkens to 148 HU inside the 1,800 HU otic capsule, where a
+true convolution would leave about 600 HU (the box average gave 10). Only voxels
 within five sigma of a surface (by exact or conservative distances) are
 blended; all others are provably their centre's material. Identical
 parameters give bit-identical arrays.
