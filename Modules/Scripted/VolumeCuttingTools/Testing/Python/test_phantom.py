@@ -266,11 +266,8 @@ def test_labelmap_classifies_voxel_centres(oblique):
         assert np.array_equal(oblique.labelmap == segment.label, segment.contains(centres))
 
 
-def test_partial_volume_equals_full_supersampling(oblique):
-    """Supersampling only near boundaries must equal supersampling everywhere."""
-    n = oblique.supersampling
-    fractions = (np.arange(n) + 0.5) / n - 0.5
-    offsets = np.array([[a, b, c] for a in fractions for b in fractions for c in fractions])
+def test_scanned_values_near_surfaces_equal_the_scanner_model_everywhere(oblique):
+    """Computing the scanner's blur only near surfaces must equal computing it at every voxel (to 0.001 HU)."""
     ni, nj, nk = oblique.dimensions
     rng = np.random.default_rng(6)
     # All voxels whose centre label differs from a neighbour, plus random ones.
@@ -284,35 +281,48 @@ def test_partial_volume_equals_full_supersampling(oblique):
         index[axis] = slice(None, -1)
         edge[tuple(index)] |= change
     kji = np.vstack([np.argwhere(edge), rng.integers(0, [nk, nj, ni], size=(3000, 3))])
-    ijk = kji[:, ::-1].astype(float)
-    samples = oblique.ijk_to_ras_points(ijk[:, None, :] + offsets[None, :, :])
-    expected = oblique.anatomy.hu_at(samples).mean(axis=1)
+    centres = oblique.ijk_to_ras_points(kji[:, ::-1].astype(float))
+    expected = oblique.anatomy._scanned_hu(centres, oblique.resolution_sigma_mm)
     actual = oblique.ct_noise_free[kji[:, 0], kji[:, 1], kji[:, 2]]
     assert np.allclose(actual, expected, rtol=0.0, atol=1e-3)
 
 
+def test_the_scanner_resolution_is_one_voxel_of_blur_on_top_of_the_voxel_average(clean):
+    # Default FWHM: the largest spacing (0.5 mm), sigma 0.212 mm; the voxel's box adds 0.5^2 / 12 mm^2.
+    assert clean.psf_fwhm_mm == 0.5
+    assert clean.resolution_sigma_mm == pytest.approx(math.sqrt((0.5 / 2.3548) ** 2 + 0.5**2 / 12.0), rel=1e-4)
+    sharp = ph.generate_phantom((16, 16, 16), (0.4, 0.4, 0.5), noise_sigma=0.0, psf_fwhm_mm=0.0)
+    assert sharp.resolution_sigma_mm == pytest.approx(math.sqrt((0.16 + 0.16 + 0.25) / 3.0 / 12.0))
+
+
 def test_partial_volume_at_skin_surface(clean):
-    """Voxels cut by the skin surface hold an air/soft-tissue mix close to the cut fraction."""
+    """Voxels across the skin hold the air/soft-tissue mix of a blurred edge: Phi(-d / sigma) of the exact distance."""
     skin = clean.segment("SoftTissue").primitives[0]
+    sigma = clean.resolution_sigma_mm
     ijk = np.argwhere(clean.labelmap <= 1)[:, ::-1]  # air or soft tissue at the centre
     centres = clean.ijk_to_ras_points(ijk)
-    near = np.abs(skin.distance_lower_bound(centres)) < 0.5
+    near = np.abs(skin.distance_lower_bound(centres)) < 2.0
     ijk, centres = ijk[near], centres[near]
     distance = skin.signed_distance(centres)
     values = clean.ct_noise_free[ijk[:, 2], ijk[:, 1], ijk[:, 0]]
     soft_fraction = (values - ph.HU_AIR) / (ph.HU_SOFT_TISSUE - ph.HU_AIR)
-    on_surface = np.abs(distance) < 0.05 * 0.5
+    # Only the skin within reach of the blur (the bone lies beneath it where the head leaves the grid).
+    lonely = np.ones(len(centres), dtype=bool)
+    for segment in clean.segments[1:]:
+        for primitive in segment.primitives:
+            lonely &= primitive.distance_lower_bound(centres) > 6.0 * sigma
+    assert lonely.sum() > 1000
+    expected = np.array([0.5 * math.erfc(d / (sigma * math.sqrt(2.0))) for d in distance[lonely]])
+    np.testing.assert_allclose(soft_fraction[lonely], expected, rtol=0.0, atol=1e-4)
+    on_surface = lonely & (np.abs(distance) < 0.05 * 0.5)
     assert on_surface.sum() > 20
-    assert np.all((soft_fraction[on_surface] > 0.25) & (soft_fraction[on_surface] < 0.75))
-    # Deeper than half a diagonal the voxel is pure.
-    pure_air = distance > 0.5 * math.sqrt(3) * 0.5
-    pure_soft = distance < -0.5 * math.sqrt(3) * 0.5
+    assert np.all((soft_fraction[on_surface] > 0.45) & (soft_fraction[on_surface] < 0.55))
+    # Farther than five sigma the voxel is pure.
+    pure_air = lonely & (distance > 5.0 * sigma)
+    pure_soft = lonely & (distance < -5.0 * sigma)
     assert pure_air.any() and pure_soft.any()
-    assert np.all(values[pure_air] == ph.HU_AIR) and np.all(values[pure_soft] == ph.HU_SOFT_TISSUE)
-    # The fraction grows monotonically (on average) from the air side to the tissue side.
-    bins = np.digitize(distance, [-0.3, -0.1, 0.1, 0.3])
-    means = [soft_fraction[bins == b].mean() for b in range(5)]
-    assert all(a > b for a, b in zip(means, means[1:]))
+    assert np.all(np.abs(values[pure_air] - ph.HU_AIR) < 1e-3)
+    assert np.all(np.abs(values[pure_soft] - ph.HU_SOFT_TISSUE) < 1e-3)
 
 
 def test_values_stay_within_material_range(clean):
@@ -388,7 +398,8 @@ def test_non_exact_segment_volume_estimate_matches_labelmap(clean):
         (dict(noise_sigma=float("nan")), "noise_sigma"),
         (dict(seed=-3), "seed"),
         (dict(scale=0.0), "scale"),
-        (dict(supersampling=0), "supersampling"),
+        (dict(psf_fwhm_mm=-0.5), "psf_fwhm_mm"),
+        (dict(psf_fwhm_mm=float("inf")), "psf_fwhm_mm"),
         (dict(ct_dtype="uint8"), "ct_dtype"),
     ],
 )

@@ -146,8 +146,8 @@ PHANTOM_DEFAULTS = {"dimensions": [128, 128, 96], "spacing": [0.4, 0.4, 0.5], "s
 
 @functools.lru_cache(maxsize=2)
 def _phantom(dimensions: tuple, spacing: tuple, seed: int) -> Scan:
-    # Labels are taken at voxel centres whatever the supersampling (which only blends HU), and noise is HU only.
-    generated = phantom.generate_phantom(dimensions=dimensions, spacing=spacing, seed=seed, noise_sigma=0.0, supersampling=1)
+    # Labels are taken at voxel centres whatever the scanner's blur (which only blends HU), and noise is HU only.
+    generated = phantom.generate_phantom(dimensions=dimensions, spacing=spacing, seed=seed, noise_sigma=0.0)
     names = list(generated.segment_names)
     opaque = tuple(phantom.BONE_SEGMENTS) + tuple(phantom.PROTECTED_SEGMENTS)
     matrix = np.eye(4)
