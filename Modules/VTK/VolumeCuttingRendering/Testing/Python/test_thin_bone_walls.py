@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import slicer_volumecutting as vc
 import vtk
+from test_cavity_shading import scaled_ijk_to_ras
 from vtkmodules.util import numpy_support
 
 SPACING = 0.25
@@ -43,13 +44,6 @@ def image(values):
     data.SetDimensions(*values.shape[::-1])
     data.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(values).ravel(), deep=True))
     return data
-
-
-def scaled(spacing):
-    matrix = vtk.vtkMatrix4x4()
-    for axis in range(3):
-        matrix.SetElement(axis, axis, spacing)
-    return matrix
 
 
 def wall(bone_below):
@@ -96,14 +90,14 @@ def render_groove(path, bone_below=True):
     caster.SetThinBoneShading(True)
     caster.SetThinBoneThickness(1.0)
     cut = vc.vtkVolumeCutField()
-    assert cut.Initialize([DIMENSIONS] * 3, scaled(SPACING), 2)
+    assert cut.Initialize([DIMENSIONS] * 3, scaled_ijk_to_ras(SPACING), 2)
     floor_centre_z = TOP - GROOVE_DEPTH + BURR_RADIUS
     assert cut.CutCapsule([centre[0] - 3.0, centre[1], floor_centre_z], [centre[0] + 3.0, centre[1], floor_centre_z],
                           BURR_RADIUS)
     caster.AddCutField(cut)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
-    volume.SetUserMatrix(scaled(SPACING))
+    volume.SetUserMatrix(scaled_ijk_to_ras(SPACING))
     renderer.AddVolume(volume)
     window.Render()
     assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
