@@ -14,6 +14,16 @@
  * voxel), so that the thickness, and the tint, vary continuously over a
  * surface instead of in quarter-voxel steps that a magnified view shows as
  * blotches (issue 28).
+ *
+ * Where two shown segments meet (cortex over trabecular bone), each one's
+ * smoothed label weight falls below one half a little before the other's
+ * rises above it, so a sliver of about a quarter voxel between them belongs
+ * to neither. The march used to end there: a thick wall read as thin
+ * wherever a step landed in the sliver, which gave red flecks and bands
+ * across drilled floors (issue 28). A gap of no material shorter than
+ * GapBridgeSteps steps, with material again beyond it, is therefore
+ * crossed as part of the wall; no air cell or canal a CT resolves is that
+ * thin.
  */
 #ifndef vtkVolumeCutThinBoneShader_h
 #define vtkVolumeCutThinBoneShader_h
@@ -46,18 +56,19 @@ public:
     const double step = 0.25 / voxelsPerMillimetre;
     for (double travelled = step; travelled < threshold; travelled += step)
     {
-      vtkVolumeCutSample s;
-      for (int axis = 0; axis < 3; ++axis)
+      bool inVolume = true;
+      if (!this->VisibleAlong(index, inwardIndex, travelled, inVolume))
       {
-        s.Index[axis] = index[axis] + travelled * inwardIndex[axis];
-        if (s.Index[axis] < 0.0 || s.Index[axis] > this->Scene.Dimensions[axis] - 1)
+        if (!inVolume)
         {
           return threshold;
         }
-      }
-      if (!this->VisibleAt(s))
-      {
-        return this->Crossing(index, inwardIndex, travelled - step, travelled);
+        double beyond = travelled;
+        if (!this->MaterialAgainWithin(index, inwardIndex, step, beyond))
+        {
+          return this->Crossing(index, inwardIndex, travelled - step, travelled);
+        }
+        travelled = beyond;
       }
     }
     return threshold;
@@ -65,6 +76,9 @@ public:
 
   /// Halvings of the last step of the march when it leaves the material.
   static constexpr int CrossingHalvings = 6;
+
+  /// The longest gap without material (in march steps, a quarter voxel each) still counted as part of a wall.
+  static constexpr int GapBridgeSteps = 2;
 
   /// Tint a shaded surface colour and its opacity by the wall's thickness there.
   void Apply(const double index[3], const double normalWorld[3], float rgb[3], float& alpha) const
@@ -87,6 +101,43 @@ private:
   {
     this->Classifier.EvaluateObject(s);
     return this->Classifier.Visible(s);
+  }
+
+  /// Whether material is visible at a distance (mm) along the inward direction; \a inVolume false off the volume.
+  bool VisibleAlong(const double index[3], const double inwardIndex[3], double distance, bool& inVolume) const
+  {
+    vtkVolumeCutSample s;
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      s.Index[axis] = index[axis] + distance * inwardIndex[axis];
+      if (s.Index[axis] < 0.0 || s.Index[axis] > this->Scene.Dimensions[axis] - 1)
+      {
+        inVolume = false;
+        return false;
+      }
+    }
+    inVolume = true;
+    return this->VisibleAt(s);
+  }
+
+  /// Whether material is visible again within GapBridgeSteps steps beyond \a distance (a sample without it);
+  /// if so, \a distance becomes where.
+  bool MaterialAgainWithin(const double index[3], const double inwardIndex[3], double step, double& distance) const
+  {
+    for (int ahead = 1; ahead <= GapBridgeSteps; ++ahead)
+    {
+      bool inVolume = true;
+      if (this->VisibleAlong(index, inwardIndex, distance + ahead * step, inVolume))
+      {
+        distance += ahead * step;
+        return true;
+      }
+      if (!inVolume)
+      {
+        return false;
+      }
+    }
+    return false;
   }
 
   /// Where the material ends between two distances (mm) along the inward

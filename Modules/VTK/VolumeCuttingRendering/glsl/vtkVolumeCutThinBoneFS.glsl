@@ -2,7 +2,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Thin-bone shading (Morris et al.): bone thinner than thinBoneThickness
 // along the inward normal turns red and translucent
-// (vtkVolumeCutThinBoneShader.h, which says why the last step is halved).
+// (vtkVolumeCutThinBoneShader.h, which says why the last step is halved and
+// why a sliver without material is crossed).
 // Replaces the skeleton's VolumeCut::ThinBone::Dec tag.
 
 uniform int thinBone;
@@ -14,6 +15,33 @@ bool visibleAt(vec3 index)
   s.index = index;
   evaluateObject(s);
   return visible(s);
+}
+
+bool insideVolume(vec3 p)
+{
+  return !(any(lessThan(p, vec3(0.0))) || any(greaterThan(p, vec3(dimensions - 1))));
+}
+
+// Whether material is visible again within two steps (half a voxel) beyond
+// a sample without it, and how far along: the sliver between two shown
+// segments' smoothed labels is part of the wall
+// (vtkVolumeCutThinBoneShader::GapBridgeSteps says why).
+bool materialAgainWithin(vec3 index, vec3 inwardIndex, float stepLength, inout float travelled)
+{
+  for (int ahead = 1; ahead <= 2; ++ahead)
+  {
+    vec3 p = index + (travelled + float(ahead) * stepLength) * inwardIndex;
+    if (!insideVolume(p))
+    {
+      return false;
+    }
+    if (visibleAt(p))
+    {
+      travelled += float(ahead) * stepLength;
+      return true;
+    }
+  }
+  return false;
 }
 
 // Where the material ends between two distances (mm) along the inward
@@ -47,13 +75,18 @@ float measureThickness(int object, vec3 index, vec3 normalWorld)
   for (float travelled = stepLength; travelled < thinBoneThickness; travelled += stepLength)
   {
     vec3 p = index + travelled * inwardIndex;
-    if (any(lessThan(p, vec3(0.0))) || any(greaterThan(p, vec3(dimensions - 1))))
+    if (!insideVolume(p))
     {
       return thinBoneThickness;
     }
     if (!visibleAt(p))
     {
-      return thinBoneCrossing(index, inwardIndex, travelled - stepLength, travelled);
+      float beyond = travelled;
+      if (!materialAgainWithin(index, inwardIndex, stepLength, beyond))
+      {
+        return thinBoneCrossing(index, inwardIndex, travelled - stepLength, travelled);
+      }
+      travelled = beyond;
     }
   }
   return thinBoneThickness;

@@ -1,0 +1,136 @@
+"""A thick wall of two shown segments is not thin bone where they meet (issue 28, findings 8 and 10).
+
+Thin-bone shading marches inward from a surface until no visible material is
+left. Two segments drawn by their smoothed shapes (the phantom's cortex over
+its protected trabecular bone) meet along a sliver where each one's fraction
+has fallen below one half before the other's rises above it: about a quarter
+voxel that belongs to neither. The march ended there, so the floor of a
+groove drilled 1 mm into a 1.6 mm cortex, over bone that goes on for
+millimetres, showed red flecks and bands wherever a march step landed in the
+sliver (the phantom journey's zoomed picture: both weights 0.47-0.49 over
+0.1 mm, a quarter of its 0.4 mm voxels). Here the same wall in analytic
+form: a slab of cortex over a bone block, their fractions linear ramps a
+voxel wide on each side of a tilted border, each short of one half by 1/16
+there, so that a quarter-voxel sliver belongs to neither, as measured on the
+phantom; a burr's groove 1 mm deep whose floor lies 0.6 mm over the border.
+No pixel of its floor may turn red, on the CPU reference and on the GLSL
+path, while a true thin wall (the same cortex over nothing) still does.
+"""
+
+import numpy as np
+import pytest
+import slicer_volumecutting as vc
+import vtk
+from test_cavity_shading import scaled_ijk_to_ras
+from vtkmodules.util import numpy_support
+
+SPACING = 0.25
+DIMENSIONS = 48
+TOP = 9.0  # mm: the cortex's outer face, z = TOP
+CORTEX_MM = 1.6
+TILT = 0.12  # the border's slope along x: its labels step one voxel every ~2 mm
+SLIVER_SHORT = 1.0 / 16.0  # how far each fraction falls short of one half at the border: a quarter-voxel sliver
+BURR_RADIUS = 1.5
+GROOVE_DEPTH = 1.0
+CORTEX, BONE = 1, 2
+WIDTH = 160
+FIELD_MM = 10.0
+CPU = vc.vtkVolumeCutVolumeMapper.CPUPath
+GPU = vc.vtkVolumeCutVolumeMapper.GPUPath
+
+
+def image(values):
+    data = vtk.vtkImageData()
+    data.SetDimensions(*values.shape[::-1])
+    data.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(values).ravel(), deep=True))
+    return data
+
+
+def wall(bone_below):
+    """Fractions (z, y, x) of the cortex slab and of the bone block under its tilted border (none without bone)."""
+    index = np.arange(DIMENSIONS) * SPACING
+    z, _, x = np.meshgrid(index, index, index, indexing="ij")
+    border = TOP - CORTEX_MM + TILT * (x - index[-1] / 2)
+
+    def ramp(mm_inside, short=0.0):
+        return np.clip(0.5 + mm_inside / (2.0 * SPACING) - short, 0.0, 1.0).astype(np.float32)
+
+    bone = ramp(np.minimum(border - z, z - 1.0), SLIVER_SHORT) if bone_below else np.zeros(z.shape, np.float32)
+    cortex = ramp(np.minimum(TOP - z, z - border), SLIVER_SHORT if bone_below else 0.0)
+    return cortex, bone
+
+
+def render_groove(path, bone_below=True):
+    """RGB (rows from the top) of the wall seen head-on, drawn by the segments' shapes with thin bone at 1 mm,
+    a groove drilled along x GROOVE_DEPTH into it."""
+    cortex, bone = wall(bone_below)
+    labels = np.where(cortex >= 0.5, CORTEX, np.where(bone >= 0.5, BONE, 0)).astype(np.uint16)
+    centre = np.full(3, (DIMENSIONS - 1) / 2 * SPACING)
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(WIDTH, WIDTH)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    camera = renderer.GetActiveCamera()
+    camera.ParallelProjectionOn()
+    camera.SetParallelScale(FIELD_MM / 2.0)
+    camera.SetFocalPoint(centre[0], centre[1], TOP)
+    camera.SetPosition(centre[0], centre[1], TOP + 60.0)
+    camera.SetViewUp(0.0, 1.0, 0.0)
+    camera.SetClippingRange(20.0, 120.0)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    mapper.SetInputData(image(np.where(labels > 0, 1000.0, -1000.0).astype(np.float32)))
+    mapper.SetRequestedRenderPath(path)
+    caster = mapper.GetRayCaster()
+    caster.SetLabelMap(image(labels))
+    caster.SetSegmentFraction(CORTEX, image(cortex))
+    caster.SetSegmentFraction(BONE, image(bone))
+    caster.SetSegmentAppearance(CORTEX, (0.94, 0.84, 0.57), 1.0, float("nan"))
+    caster.SetSegmentAppearance(BONE, (0.85, 0.73, 0.51), 1.0, float("nan"))
+    caster.SetThinBoneShading(True)
+    caster.SetThinBoneThickness(1.0)
+    cut = vc.vtkVolumeCutField()
+    assert cut.Initialize([DIMENSIONS] * 3, scaled_ijk_to_ras(SPACING), 2)
+    floor_centre_z = TOP - GROOVE_DEPTH + BURR_RADIUS
+    assert cut.CutCapsule([centre[0] - 3.0, centre[1], floor_centre_z], [centre[0] + 3.0, centre[1], floor_centre_z],
+                          BURR_RADIUS)
+    caster.AddCutField(cut)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetUserMatrix(scaled_ijk_to_ras(SPACING))
+    renderer.AddVolume(volume)
+    window.Render()
+    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, WIDTH - 1, WIDTH - 1, 1, rgba)
+    return numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[::-1, :, :3].astype(int)
+
+
+def floor_pixels():
+    """The groove's floor in the picture: within 1 mm of its axis, its straight part."""
+    rows, columns = np.mgrid[0:WIDTH, 0:WIDTH]
+    mm = FIELD_MM / WIDTH
+    return (np.abs(rows - (WIDTH - 1) / 2) * mm < 1.0) & (np.abs(columns - (WIDTH - 1) / 2) * mm < 2.5)
+
+
+def red(rgb):
+    return rgb[..., 0] - rgb[..., 1] > 40
+
+
+@pytest.mark.parametrize("path", [CPU, GPU], ids=["cpu", "gpu"])
+def test_a_groove_over_a_second_segment_is_not_thin_bone(path):
+    rgb = render_groove(path)
+    floor = floor_pixels()
+    flecks = int(np.count_nonzero(red(rgb) & floor))
+    # Before the gap was crossed: 1,838 red pixels of the 2,560 on the floor on both paths, a red wedge (the
+    # distance to the tilted sliver) crossed by dark lines where a march step fell into it.
+    assert flecks == 0, f"{flecks} red pixels of {int(floor.sum())} on a groove's floor 0.6 mm over more bone"
+    # Where the cortex is whole, nothing turns red either.
+    assert not red(rgb)[:10].any()
+
+
+def test_a_truly_thin_wall_still_turns_red():
+    rgb = render_groove(CPU, bone_below=False)
+    floor = floor_pixels()
+    # 0.6 mm of cortex over nothing: red, in proportion, on the whole floor.
+    assert np.count_nonzero(red(rgb) & floor) > 0.5 * floor.sum()
