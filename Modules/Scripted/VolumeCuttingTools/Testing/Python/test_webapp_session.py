@@ -14,6 +14,7 @@ import pyigtl
 import pytest
 import slicer
 import vtk
+from vtkmodules.util import numpy_support
 
 from VolumeCuttingLib.collaboration import igtlbridge
 from VolumeCuttingLib.collaboration.igtlclient import RecordingClient
@@ -284,6 +285,61 @@ def test_surface_depth_finds_the_surface_under_a_pixel():
     window.Render()
     np.testing.assert_allclose(frozen.surface_point(0.5, 0.5)[0], (0.0, 0.0, 5.0), atol=0.05)
     assert depth.surface_point(1.5, 0.5) is None
+    window.Finalize()
+
+
+def test_a_burr_follows_the_surface_under_its_footprint_not_each_pixel():
+    """A tilted plane with 0.1 mm ripples of 1.7 mm (the rendered phantom's surface), seen at 0.07 mm per pixel.
+
+    Per pixel the surface point rides the ripples, and on a frame drawn while the camera moved (one depth per
+    4 x 4 pixels) it jumps at each block: a stroke at a fixed depth copied both into its floor as bands. Over a
+    1 mm footprint the point lies on the plane within a fraction of the ripple.
+    """
+    renderer = vtk.vtkRenderer()
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(True)
+    window.SetMultiSamples(0)
+    window.SetSize(240, 200)
+    window.AddRenderer(renderer)
+    plane = vtk.vtkPlaneSource()
+    plane.SetOrigin(-20, -20, 0.0)
+    plane.SetPoint1(20, -20, 0.0)
+    plane.SetPoint2(-20, 20, 0.0)
+    plane.SetResolution(800, 800)
+    plane.Update()
+    surface = plane.GetOutput()
+    xyz = numpy_support.vtk_to_numpy(surface.GetPoints().GetData()).astype(float)
+    tilt = 0.3  # mm of height per mm along x
+    amplitude, period = 0.1, 1.7
+    xyz[:, 2] = tilt * xyz[:, 0] + amplitude * np.sin(2.0 * np.pi * xyz[:, 0] / period)
+    surface.GetPoints().SetData(numpy_support.numpy_to_vtk(xyz, deep=True))
+    mapper = vtk.vtkPolyDataMapper()
+    mapper.SetInputData(surface)
+    actor = vtk.vtkActor()
+    actor.SetMapper(mapper)
+    renderer.AddActor(actor)
+    camera = renderer.GetActiveCamera()
+    camera.SetPosition(0, 0, 30)
+    camera.SetFocalPoint(0, 0, 0)
+    renderer.ResetCameraClippingRange()
+    depth = views.SurfaceDepth(renderer)
+    window.Render()
+    coarse = depth.snapshot()
+    rows, columns = coarse.depth.shape
+    blocks = coarse.depth[: rows - rows % 4, : columns - columns % 4]
+    coarse.depth[: rows - rows % 4, : columns - columns % 4] = np.repeat(np.repeat(blocks[::4, ::4], 4, axis=0), 4, axis=1)
+
+    def heights(source, footprint):
+        # Height above the ripple-free plane z = tilt x along a stroke (the rays are vertical within 0.1 degrees).
+        points = [source.surface_point(fx, 0.5, footprint_mm=footprint)[0] for fx in np.linspace(0.3, 0.7, 81)]
+        return np.array([point[2] - tilt * point[0] for point in points])
+
+    # What a floor shows is how the height swings along the stroke (a constant offset leaves it flat).
+    swing = {(name, footprint): float(np.ptp(heights(source, footprint)))
+             for name, source in (("fine", depth), ("coarse", coarse)) for footprint in (0.0, 1.0)}
+    assert swing["fine", 0.0] > 0.15 and swing["coarse", 0.0] > 0.15, swing
+    assert swing["fine", 1.0] < 0.03 and swing["coarse", 1.0] < 0.03, swing
+    assert np.abs(heights(depth, 1.0)).max() < 0.03
     window.Finalize()
 
 

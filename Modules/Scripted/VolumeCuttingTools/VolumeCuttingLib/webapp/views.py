@@ -35,6 +35,10 @@ from .session import tool_pose
 
 # Window depth of pixels where no surface was drawn.
 _BACKGROUND_DEPTH = 1.0 - 1e-6
+# The surface under a burr is read from at most this many pixels either side of the pointer (a 25 x 25 window),
+# and from at least this many pixels on the surface.
+_FOOTPRINT_MAX_PIXELS = 12
+_FOOTPRINT_MIN_PIXELS = 6
 
 
 class SurfaceDepth:
@@ -85,7 +89,10 @@ class SurfaceDepth:
         copy._parallel_direction = self._parallel_direction
         return copy
 
-    def surface_point(self, fx: float, fy: float):
+    def surface_point(self, fx: float, fy: float, footprint_mm: float = 0.0):
+        """With ``footprint_mm`` > 0 the point lies on the plane fitted to the surface within that radius of the
+        pixel's point: a burr follows the surface under its whole footprint, not each pixel's noise, nor the
+        4 x 4 blocks of a frame drawn while the camera moved (both printed bands across a drilled groove)."""
         if self.depth is None or not (0.0 <= fx <= 1.0 and 0.0 <= fy <= 1.0):
             return None
         rows, columns = self.depth.shape
@@ -94,16 +101,56 @@ class SurfaceDepth:
         depth = float(self.depth[row, column])
         if depth >= _BACKGROUND_DEPTH:
             return None
-        ndc = np.array([2.0 * fx - 1.0, 2.0 * fy - 1.0, 2.0 * depth - 1.0, 1.0])
-        world = self._ndc_to_world @ ndc
-        if world[3] == 0.0:
+        point = self._unproject(np.array([fx]), np.array([fy]), np.array([depth]))
+        if point is None:
             return None
-        point = world[:3] / world[3]
+        point = point[0]
         direction = self._parallel_direction if self._parallel_direction is not None else point - self._eye
         norm = np.linalg.norm(direction)
         if not np.isfinite(norm) or norm == 0.0:
             return None
-        return point, direction / norm
+        direction = direction / norm
+        if footprint_mm > 0.0:
+            point = self._footprint_point(fx, fy, row, column, point, direction, footprint_mm)
+        return point, direction
+
+    def _unproject(self, fx, fy, depth):
+        ndc = np.stack([2.0 * fx - 1.0, 2.0 * fy - 1.0, 2.0 * depth - 1.0, np.ones_like(fx)])
+        world = self._ndc_to_world @ ndc
+        if np.any(world[3] == 0.0):
+            return None
+        return (world[:3] / world[3]).T
+
+    def _footprint_point(self, fx, fy, row, column, point, direction, footprint_mm):
+        rows, columns = self.depth.shape
+        beside = self._unproject(np.array([fx + 1.0 / columns]), np.array([fy]), np.array([self.depth[row, column]]))
+        pixel_mm = float(np.linalg.norm(beside[0] - point)) if beside is not None else 0.0
+        if not np.isfinite(pixel_mm) or pixel_mm <= 0.0:
+            return point
+        reach = int(min(_FOOTPRINT_MAX_PIXELS, np.ceil(footprint_mm / pixel_mm)))
+        if reach < 1:
+            return point
+        r0, r1 = max(0, row - reach), min(rows, row + reach + 1)
+        c0, c1 = max(0, column - reach), min(columns, column + reach + 1)
+        window = self.depth[r0:r1, c0:c1]
+        r, c = np.nonzero(window < _BACKGROUND_DEPTH)
+        if len(r) < _FOOTPRINT_MIN_PIXELS:
+            return point
+        du = (c0 + c + 0.5) / columns - fx
+        dv = (r0 + r + 0.5) / rows - fy
+        points = self._unproject(fx + du, fy + dv, window[r, c].astype(float))
+        if points is None:
+            return point
+        # Only the surface under the footprint: a silhouette's far side or another structure in front is left out.
+        near = np.linalg.norm(points - point, axis=1) <= footprint_mm
+        if near.sum() < _FOOTPRINT_MIN_PIXELS:
+            return point
+        along = (points[near] - point) @ direction
+        design = np.stack([np.ones(int(near.sum())), du[near] * columns, dv[near] * rows], axis=1)
+        solution, _, rank, _ = np.linalg.lstsq(design, along, rcond=None)
+        if rank < 3 or not np.isfinite(solution[0]) or abs(solution[0]) > footprint_mm:
+            return point
+        return point + solution[0] * direction
 
 
 def add_product_displayable_manager(view, manager):
@@ -480,13 +527,13 @@ class DrillPipeline(vtkMRMLLayerDMScriptedPipeline):
         source = self._depth_source()
         if source is None:
             return None, None
-        hit = source.surface_point(*self._fraction(event_data))
+        session = self.controller.session
+        reach = session.tool_reach()
+        hit = source.surface_point(*self._fraction(event_data), footprint_mm=reach)
         if hit is None:
             return None, None
         point, direction = hit
         camera = self.view.renderer().GetActiveCamera()
-        session = self.controller.session
-        reach = session.tool_reach()
         pose = tool_pose(point, direction, depth_mm, reach, camera.GetViewUp())
         guide = self.controller.guide
         if guide is not None:
