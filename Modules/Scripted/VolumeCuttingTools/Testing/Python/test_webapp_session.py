@@ -252,22 +252,30 @@ def test_a_zip_that_reaches_outside_its_folder_is_refused(tmp_path):
         webapp.unpack_upload([huge], tmp_path / "huge", 2**20)
 
 
-def test_surface_depth_finds_the_surface_under_a_pixel():
+def plane_in_offscreen_view(size, half_width, height, resolution=1):
+    """A square plane at z = height seen by an offscreen renderer of that size: (renderer, window, plane)."""
     renderer = vtk.vtkRenderer()
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(True)
     window.SetMultiSamples(0)
-    window.SetSize(200, 160)
+    window.SetSize(*size)
     window.AddRenderer(renderer)
     plane = vtk.vtkPlaneSource()
-    plane.SetOrigin(-50, -50, 5.0)
-    plane.SetPoint1(50, -50, 5.0)
-    plane.SetPoint2(-50, 50, 5.0)
+    plane.SetOrigin(-half_width, -half_width, height)
+    plane.SetPoint1(half_width, -half_width, height)
+    plane.SetPoint2(-half_width, half_width, height)
+    plane.SetResolution(resolution, resolution)
+    plane.Update()
     mapper = vtk.vtkPolyDataMapper()
-    mapper.SetInputConnection(plane.GetOutputPort())
+    mapper.SetInputData(plane.GetOutput())
     actor = vtk.vtkActor()
     actor.SetMapper(mapper)
     renderer.AddActor(actor)
+    return renderer, window, plane.GetOutput()
+
+
+def test_surface_depth_finds_the_surface_under_a_pixel():
+    renderer, window, _ = plane_in_offscreen_view((200, 160), 50, 5.0)
     camera = renderer.GetActiveCamera()
     camera.SetPosition(0, 0, 100)
     camera.SetFocalPoint(0, 0, 0)
@@ -295,29 +303,12 @@ def test_a_burr_follows_the_surface_under_its_footprint_not_each_pixel():
     4 x 4 pixels) it jumps at each block: a stroke at a fixed depth copied both into its floor as bands. Over a
     1 mm footprint the point lies on the plane within a fraction of the ripple.
     """
-    renderer = vtk.vtkRenderer()
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(True)
-    window.SetMultiSamples(0)
-    window.SetSize(240, 200)
-    window.AddRenderer(renderer)
-    plane = vtk.vtkPlaneSource()
-    plane.SetOrigin(-20, -20, 0.0)
-    plane.SetPoint1(20, -20, 0.0)
-    plane.SetPoint2(-20, 20, 0.0)
-    plane.SetResolution(800, 800)
-    plane.Update()
-    surface = plane.GetOutput()
+    renderer, window, surface = plane_in_offscreen_view((240, 200), 20, 0.0, resolution=800)
     xyz = numpy_support.vtk_to_numpy(surface.GetPoints().GetData()).astype(float)
     tilt = 0.3  # mm of height per mm along x
     amplitude, period = 0.1, 1.7
     xyz[:, 2] = tilt * xyz[:, 0] + amplitude * np.sin(2.0 * np.pi * xyz[:, 0] / period)
     surface.GetPoints().SetData(numpy_support.numpy_to_vtk(xyz, deep=True))
-    mapper = vtk.vtkPolyDataMapper()
-    mapper.SetInputData(surface)
-    actor = vtk.vtkActor()
-    actor.SetMapper(mapper)
-    renderer.AddActor(actor)
     camera = renderer.GetActiveCamera()
     camera.SetPosition(0, 0, 30)
     camera.SetFocalPoint(0, 0, 0)
