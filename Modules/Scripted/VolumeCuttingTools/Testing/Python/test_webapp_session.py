@@ -252,6 +252,15 @@ def test_a_zip_that_reaches_outside_its_folder_is_refused(tmp_path):
         webapp.unpack_upload([huge], tmp_path / "huge", 2**20)
 
 
+def place_camera_above(renderer, height):
+    """The camera on the z axis at that height, looking down at the origin."""
+    camera = renderer.GetActiveCamera()
+    camera.SetPosition(0, 0, height)
+    camera.SetFocalPoint(0, 0, 0)
+    renderer.ResetCameraClippingRange()
+    return camera
+
+
 def plane_in_offscreen_view(size, half_width, height, resolution=1):
     """A square plane at z = height seen by an offscreen renderer of that size: (renderer, window, plane)."""
     renderer = vtk.vtkRenderer()
@@ -276,10 +285,7 @@ def plane_in_offscreen_view(size, half_width, height, resolution=1):
 
 def test_surface_depth_finds_the_surface_under_a_pixel():
     renderer, window, _ = plane_in_offscreen_view((200, 160), 50, 5.0)
-    camera = renderer.GetActiveCamera()
-    camera.SetPosition(0, 0, 100)
-    camera.SetFocalPoint(0, 0, 0)
-    renderer.ResetCameraClippingRange()
+    place_camera_above(renderer, 100)
     depth = views.SurfaceDepth(renderer)
     window.Render()
     point, direction = depth.surface_point(0.5, 0.5)
@@ -288,8 +294,7 @@ def test_surface_depth_finds_the_surface_under_a_pixel():
     point, _ = depth.surface_point(0.75, 0.5)
     assert point[0] > 5.0 and point[2] == pytest.approx(5.0, abs=0.05)
     frozen = depth.snapshot()
-    camera.SetPosition(0, 0, 60)
-    renderer.ResetCameraClippingRange()
+    place_camera_above(renderer, 60)
     window.Render()
     np.testing.assert_allclose(frozen.surface_point(0.5, 0.5)[0], (0.0, 0.0, 5.0), atol=0.05)
     assert depth.surface_point(1.5, 0.5) is None
@@ -309,10 +314,7 @@ def test_a_burr_follows_the_surface_under_its_footprint_not_each_pixel():
     amplitude, period = 0.1, 1.7
     xyz[:, 2] = tilt * xyz[:, 0] + amplitude * np.sin(2.0 * np.pi * xyz[:, 0] / period)
     surface.GetPoints().SetData(numpy_support.numpy_to_vtk(xyz, deep=True))
-    camera = renderer.GetActiveCamera()
-    camera.SetPosition(0, 0, 30)
-    camera.SetFocalPoint(0, 0, 0)
-    renderer.ResetCameraClippingRange()
+    place_camera_above(renderer, 30)
     depth = views.SurfaceDepth(renderer)
     window.Render()
     coarse = depth.snapshot()
