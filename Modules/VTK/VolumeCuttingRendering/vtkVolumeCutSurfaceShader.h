@@ -191,6 +191,13 @@ public:
     {
       std::copy(ray.EntryNormal, ray.EntryNormal + 3, normal);
     }
+    // Lit from the eye whichever way the estimate points; but where the
+    // estimate turns away from the eye (at outlines seen edge-on, by a few
+    // degrees), the flipped normal points into the material, and thin-bone
+    // shading marching against it left the material at once: a one-pixel
+    // red rim around thick bone (issue 28). Occlusion and thickness look
+    // from the material outwards, so they keep the outward estimate.
+    const double outward[3] = { normal[0], normal[1], normal[2] };
     if (vtkMath::Dot(normal, ray.View) < 0.0)
     {
       for (int axis = 0; axis < 3; ++axis)
@@ -204,12 +211,12 @@ public:
     float alpha = style.Opacity;
     if (this->Scene.AmbientOcclusion)
     {
-      this->Occlusion.Apply(index, normal, ray.ViewAxis, rgb);
+      this->Occlusion.Apply(index, outward, ray.ViewAxis, rgb);
       this->Cavity.Apply(index, ray.View, rgb);
     }
     if (this->Scene.ThinBone)
     {
-      this->ThinBone.Apply(index, normal, rgb, alpha);
+      this->ThinBone.Apply(index, outward, rgb, alpha);
     }
     result.Record(ray, t, source, owner, normal, rgb, alpha, 0.f);
     return result.Opaque() || ++result.Layers >= vtkVolumeCutRayResult::MaximumLayers;

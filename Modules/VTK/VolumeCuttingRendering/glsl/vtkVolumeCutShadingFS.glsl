@@ -98,6 +98,8 @@ bool enter(Sample piece, float t, int source)
   {
     normal = entryNormal;
   }
+  // Occlusion and thin bone keep the outward estimate (vtkVolumeCutSurfaceShader::Enter says why).
+  vec3 outward = normal;
   if (dot(normal, viewVector) < 0.0)
   {
     normal = -normal;
@@ -107,12 +109,12 @@ bool enter(Sample piece, float t, int source)
   float alpha = style.a;
   if (ambientOcclusion != 0)
   {
-    rgb *= 1.0 - 0.9 * occlusion(index, normal);
+    rgb *= 1.0 - 0.9 * occlusion(index, outward);
     rgb *= cavityShade(index, viewVector);
   }
   if (thinBone != 0)
   {
-    applyThinBone(piece.object, index, normal, rgb, alpha);
+    applyThinBone(piece.object, index, outward, rgb, alpha);
   }
   record(t, rgb, alpha, 0.0);
   ++layers;

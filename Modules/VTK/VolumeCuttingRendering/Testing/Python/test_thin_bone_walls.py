@@ -15,6 +15,12 @@ there, so that a quarter-voxel sliver belongs to neither, as measured on the
 phantom; a burr's groove 1 mm deep whose floor lies 0.6 mm over the border.
 No pixel of its floor may turn red, on the CPU reference and on the GLSL
 path, while a true thin wall (the same cortex over nothing) still does.
+
+Nor may the outline of thick bone: where a surface is seen edge-on, its
+estimated normal turns a few degrees away from the eye, lighting flips it
+back, and the march against the flipped normal left the material at its
+first step: a one-pixel red rim around the temporal bone's mastoid in the
+journey's first picture.
 """
 
 import numpy as np
@@ -106,6 +112,51 @@ def render_groove(path, bone_below=True):
     return numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[::-1, :, :3].astype(int)
 
 
+def render_ball(path, drawn_by_labels):
+    """RGB of a ball 12 mm across (a CT with a scanner's blur and noise, or a labelmap) with thin bone at 1 mm,
+    seen from above and aside so that the whole outline is edge-on."""
+    spacing, size, radius, width = 0.25, 64, 6.0, 200
+    centre = (size - 1) / 2 * spacing
+    z, y, x = np.mgrid[0:size, 0:size, 0:size] * spacing
+    inside = np.sqrt((x - centre) ** 2 + (y - centre) ** 2 + (z - centre) ** 2) < radius
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(width, width)
+    renderer = vtk.vtkRenderer()
+    window.AddRenderer(renderer)
+    camera = renderer.GetActiveCamera()
+    camera.SetFocalPoint(centre, centre, centre)
+    camera.SetPosition(centre + 10.0, centre + 20.0, centre + 60.0)
+    camera.SetViewAngle(20.0)
+    mapper = vc.vtkVolumeCutVolumeMapper()
+    ct = np.where(inside, 1000.0, -1000.0).astype(np.float32)
+    # A scanner's blur (a box of three voxels, twice) and noise, so that the CT's gradient wavers at the outline.
+    for axis in range(3):
+        for _ in range(2):
+            ct = (np.roll(ct, 1, axis) + ct + np.roll(ct, -1, axis)) / 3.0
+    ct += np.random.default_rng(28).normal(0.0, 25.0, ct.shape).astype(np.float32)
+    mapper.SetInputData(image(ct))
+    mapper.SetRequestedRenderPath(path)
+    caster = mapper.GetRayCaster()
+    caster.SetIsoValue(0.0)
+    caster.SetAmbientOcclusion(True)
+    if drawn_by_labels:
+        caster.SetLabelMap(image(inside.astype(np.uint16)))
+        caster.SetSegmentAppearance(1, (0.94, 0.84, 0.57), 1.0, float("nan"))
+    caster.SetThinBoneShading(True)
+    caster.SetThinBoneThickness(1.0)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetUserMatrix(scaled_ijk_to_ras(spacing))
+    renderer.AddVolume(volume)
+    renderer.ResetCameraClippingRange()
+    window.Render()
+    assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
+    return numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4)[::-1, :, :3].astype(int)
+
+
 def floor_pixels():
     """The groove's floor in the picture: within 1 mm of its axis, its straight part."""
     rows, columns = np.mgrid[0:WIDTH, 0:WIDTH]
@@ -134,3 +185,14 @@ def test_a_truly_thin_wall_still_turns_red():
     floor = floor_pixels()
     # 0.6 mm of cortex over nothing: red, in proportion, on the whole floor.
     assert np.count_nonzero(red(rgb) & floor) > 0.5 * floor.sum()
+
+
+@pytest.mark.parametrize("drawn_by_labels", [False, True], ids=["ct", "labels"])
+@pytest.mark.parametrize("path", [CPU, GPU], ids=["cpu", "gpu"])
+def test_the_outline_of_thick_bone_is_not_thin_bone(path, drawn_by_labels):
+    rgb = render_ball(path, drawn_by_labels)
+    shown = rgb.sum(axis=2) > 30
+    assert shown.sum() > 8000
+    # Before: 6-30 red pixels, every one on the outline (300 pixels wide: 14 from the CT, 65 from the labels).
+    rim = int(np.count_nonzero(red(rgb)))
+    assert rim == 0, f"{rim} red pixels on the outline of a ball 12 mm across"
