@@ -214,7 +214,11 @@ public:
       this->Occlusion.Apply(index, outward, ray.ViewAxis, rgb);
       this->Cavity.Apply(index, ray.View, rgb);
     }
-    if (this->Scene.ThinBone)
+    // Only bone's own surfaces and those a cut exposed have a wall under
+    // them; where the scan ends or a clip plane cuts, the march along the face
+    // runs nearly along the adjacent surfaces at the face's edges, through the
+    // partial-volume fringe and its noise, and tinted the edges red.
+    if (this->Scene.ThinBone && (source == vtkVolumeCutRayCaster::SourceObject || source >= vtkVolumeCutRayCaster::SourceCutField))
     {
       this->ThinBone.Apply(index, outward, rgb, alpha);
     }

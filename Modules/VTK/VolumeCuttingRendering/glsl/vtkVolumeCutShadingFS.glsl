@@ -112,7 +112,8 @@ bool enter(Sample piece, float t, int source)
     rgb *= 1.0 - 0.9 * occlusion(index, outward);
     rgb *= cavityShade(index, viewVector);
   }
-  if (thinBone != 0)
+  // Not on the scan's end faces or clip planes (vtkVolumeCutSurfaceShader::Enter says why).
+  if (thinBone != 0 && (source == SOURCE_OBJECT || source >= SOURCE_CUT))
   {
     applyThinBone(piece.object, index, outward, rgb, alpha);
   }

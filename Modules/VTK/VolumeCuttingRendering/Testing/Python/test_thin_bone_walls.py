@@ -112,29 +112,26 @@ def render_groove(path, bone_below=True):
     return numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[::-1, :, :3].astype(int)
 
 
-def render_ball(path, drawn_by_labels):
-    """RGB of a ball 12 mm across (a CT with a scanner's blur and noise, or a labelmap) with thin bone at 1 mm,
-    seen from above and aside so that the whole outline is edge-on."""
-    spacing, size, radius, width = 0.25, 64, 6.0, 200
-    centre = (size - 1) / 2 * spacing
-    z, y, x = np.mgrid[0:size, 0:size, 0:size] * spacing
-    inside = np.sqrt((x - centre) ** 2 + (y - centre) ** 2 + (z - centre) ** 2) < radius
+def render_solid(path, inside, spacing, focal_point, eye_offset, drawn_by_labels=False, width=200):
+    """RGB of a thick solid (a mask, z y x) with thin bone at 1 mm: a CT of it with a scanner's blur (a box of
+    three voxels, twice; the scan's border faces left whole) and noise, or its labelmap."""
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
     window.SetSize(width, width)
     renderer = vtk.vtkRenderer()
     window.AddRenderer(renderer)
     camera = renderer.GetActiveCamera()
-    camera.SetFocalPoint(centre, centre, centre)
-    camera.SetPosition(centre + 10.0, centre + 20.0, centre + 60.0)
+    camera.SetFocalPoint(*focal_point)
+    camera.SetPosition(*(np.asarray(focal_point) + eye_offset))
+    camera.SetViewUp(0.0, 0.0, 1.0)
     camera.SetViewAngle(20.0)
-    mapper = vc.vtkVolumeCutVolumeMapper()
     ct = np.where(inside, 1000.0, -1000.0).astype(np.float32)
-    # A scanner's blur (a box of three voxels, twice) and noise, so that the CT's gradient wavers at the outline.
     for axis in range(3):
         for _ in range(2):
             ct = (np.roll(ct, 1, axis) + ct + np.roll(ct, -1, axis)) / 3.0
+    ct[inside & (np.indices(inside.shape).min(axis=0) < 2)] = 1000.0
     ct += np.random.default_rng(28).normal(0.0, 25.0, ct.shape).astype(np.float32)
+    mapper = vc.vtkVolumeCutVolumeMapper()
     mapper.SetInputData(image(ct))
     mapper.SetRequestedRenderPath(path)
     caster = mapper.GetRayCaster()
@@ -147,7 +144,10 @@ def render_ball(path, drawn_by_labels):
     caster.SetThinBoneThickness(1.0)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
-    volume.SetUserMatrix(scaled_ijk_to_ras(spacing))
+    matrix = vtk.vtkMatrix4x4()
+    for axis in range(3):
+        matrix.SetElement(axis, axis, spacing[axis])
+    volume.SetUserMatrix(matrix)
     renderer.AddVolume(volume)
     renderer.ResetCameraClippingRange()
     window.Render()
@@ -190,9 +190,28 @@ def test_a_truly_thin_wall_still_turns_red():
 @pytest.mark.parametrize("drawn_by_labels", [False, True], ids=["ct", "labels"])
 @pytest.mark.parametrize("path", [CPU, GPU], ids=["cpu", "gpu"])
 def test_the_outline_of_thick_bone_is_not_thin_bone(path, drawn_by_labels):
-    rgb = render_ball(path, drawn_by_labels)
-    shown = rgb.sum(axis=2) > 30
-    assert shown.sum() > 8000
-    # Before: 6-30 red pixels, every one on the outline (300 pixels wide: 14 from the CT, 65 from the labels).
+    """A ball 12 mm across seen from above and aside: its whole outline is seen edge-on."""
+    spacing, size = 0.25, 64
+    centre = (size - 1) / 2 * spacing
+    z, y, x = np.mgrid[0:size, 0:size, 0:size] * spacing
+    inside = (x - centre) ** 2 + (y - centre) ** 2 + (z - centre) ** 2 < 6.0 ** 2
+    rgb = render_solid(path, inside, (spacing,) * 3, (centre,) * 3, (10.0, 60.0, 20.0), drawn_by_labels)
+    assert np.count_nonzero(rgb.sum(axis=2) > 30) > 8000
+    # Before: 3 (CT) and 24-26 (labels) red pixels, every one on the outline.
     rim = int(np.count_nonzero(red(rgb)))
     assert rim == 0, f"{rim} red pixels on the outline of a ball 12 mm across"
+
+
+@pytest.mark.parametrize("path", [CPU, GPU], ids=["cpu", "gpu"])
+def test_where_the_scan_ends_is_not_thin_bone(path):
+    """A block of bone 9.6 x 9.6 x 14 mm filling a corner of the scan (0.4 x 0.4 x 0.7 mm voxels), its three faces
+    where the scan ends seen corner-on: the march along an end face's normal runs, at the face's edges, through the
+    partial-volume fringe of the block's own surfaces."""
+    spacing = (0.4, 0.4, 0.7)
+    k, j, i = np.mgrid[0:40, 0:40, 0:40]
+    inside = (i < 24) & (j < 24) & (k < 20)
+    rgb = render_solid(path, inside, spacing, (0.0, 0.0, 6.65), (-40.0, -30.0, -25.0))
+    assert np.count_nonzero(rgb.sum(axis=2) > 30) > 8000
+    # Before: 164 red pixels on both paths, a rim along the end faces' outer edges.
+    rim = int(np.count_nonzero(red(rgb)))
+    assert rim == 0, f"{rim} red pixels along the edges of the faces where the scan ends"
