@@ -28,6 +28,7 @@ import pytest
 import slicer_volumecutting as vc
 import vtk
 from test_cavity_shading import scaled_ijk_to_ras
+from test_volume_cut_mapper import read_window, render_window
 from vtkmodules.util import numpy_support
 
 SPACING = 0.25
@@ -72,11 +73,7 @@ def render_groove(path, bone_below=True):
     cortex, bone = wall(bone_below)
     labels = np.where(cortex >= 0.5, CORTEX, np.where(bone >= 0.5, BONE, 0)).astype(np.uint16)
     centre = np.full(3, (DIMENSIONS - 1) / 2 * SPACING)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(WIDTH, WIDTH)
-    renderer = vtk.vtkRenderer()
-    window.AddRenderer(renderer)
+    window, renderer = render_window(WIDTH)
     camera = renderer.GetActiveCamera()
     camera.ParallelProjectionOn()
     camera.SetParallelScale(FIELD_MM / 2.0)
@@ -107,19 +104,13 @@ def render_groove(path, bone_below=True):
     renderer.AddVolume(volume)
     window.Render()
     assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, WIDTH - 1, WIDTH - 1, 1, rgba)
-    return numpy_support.vtk_to_numpy(rgba).reshape(WIDTH, WIDTH, 4)[::-1, :, :3].astype(int)
+    return read_window(window, WIDTH)[1][::-1, :, :3]
 
 
 def render_solid(path, inside, spacing, focal_point, eye_offset, drawn_by_labels=False, width=200):
     """RGB of a thick solid (a mask, z y x) with thin bone at 1 mm: a CT of it with a scanner's blur (a box of
     three voxels, twice; the scan's border faces left whole) and noise, or its labelmap."""
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(width, width)
-    renderer = vtk.vtkRenderer()
-    window.AddRenderer(renderer)
+    window, renderer = render_window(width)
     camera = renderer.GetActiveCamera()
     camera.SetFocalPoint(*focal_point)
     camera.SetPosition(*(np.asarray(focal_point) + eye_offset))
@@ -152,9 +143,7 @@ def render_solid(path, inside, spacing, focal_point, eye_offset, drawn_by_labels
     renderer.ResetCameraClippingRange()
     window.Render()
     assert mapper.GetLastRenderPath() == path, mapper.GetGPUFallbackReason()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, width - 1, width - 1, 1, rgba)
-    return numpy_support.vtk_to_numpy(rgba).reshape(width, width, 4)[::-1, :, :3].astype(int)
+    return read_window(window, width)[1][::-1, :, :3]
 
 
 def floor_pixels():
