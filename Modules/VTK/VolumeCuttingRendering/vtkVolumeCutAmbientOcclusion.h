@@ -27,6 +27,11 @@
  *   by the smallest rotation, which is undefined only for a normal facing
  *   away from the eye, never drawn. A tangent chosen by comparing the
  *   normal's components switched where they crossed a threshold.
+ * - Where the scan ends, the material ends: a point's depth is also at most
+ *   its distance to the volume's faces. Counted fully up to the face and
+ *   nothing beyond it, a point crossing an end face drew straight seams
+ *   across a cut wall near the scan's border (the own-block journey's
+ *   close-up).
  * Points outside material count 0 as before, so flat and convex surfaces
  * stay unoccluded and empty space is still skipped.
  */
@@ -156,9 +161,9 @@ private:
   }
 
   /**
-   * Depth (mm) of a visible sample in its material: the smaller of its
-   * distance to the nearest cut and its object field's value over the
-   * field's gradient (central differences a voxel apart), the CT above the
+   * Depth (mm) of a visible sample in its material: the smallest of its
+   * distance to the nearest cut, to the volume's faces, and its object
+   * field's value over the field's gradient (central differences a voxel apart), the CT above the
    * segment's iso-value or a shape segment's indicator above 0.5.
    */
   double Depth(vtkVolumeCutSample& s) const
@@ -168,6 +173,14 @@ private:
     for (size_t n = 0; n < scene.CutFields.size(); ++n)
     {
       depth = std::min(depth, s.Distance[n]);
+    }
+    for (int axis = 0; axis < 3; ++axis)
+    {
+      // Index units per mm across the faces of this axis: the norm of world-to-IJK's row.
+      const double* row = scene.WorldToIJK + 4 * axis;
+      const double perMillimetre = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+      const double toFace = std::min(s.Index[axis], scene.Dimensions[axis] - 1 - s.Index[axis]);
+      depth = std::min(depth, toFace / perMillimetre);
     }
     const int label = scene.HasSegments() ? s.Object : 1;
     const bool shape = scene.HasSegments() && scene.Styles[label].Shape;

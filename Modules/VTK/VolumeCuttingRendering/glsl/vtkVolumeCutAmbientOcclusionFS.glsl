@@ -23,15 +23,21 @@ vec3 occlusionTangent(vec3 n, vec3 a)
   return normalize(t0 - k * (n + a));
 }
 
-// Depth (mm) of a visible sample in its material: the smaller of its
-// distance to the nearest cut and its object field's value over the field's
-// gradient (central differences a voxel apart).
+// Depth (mm) of a visible sample in its material: the smallest of its
+// distance to the nearest cut, to the volume's faces, and its object field's
+// value over the field's gradient (central differences a voxel apart).
 float occlusionDepth(Sample s)
 {
   float depth = 1.0e30;
   for (int n = 0; n < NUMBER_OF_CUTS; ++n)
   {
     depth = min(depth, s.distance[n]);
+  }
+  // At most the distance to the volume's faces: the material ends where the scan does.
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    vec3 row = vec3(worldToIJK[0][axis], worldToIJK[1][axis], worldToIJK[2][axis]);
+    depth = min(depth, min(s.index[axis], float(dimensions[axis] - 1) - s.index[axis]) / length(row));
   }
   int label = hasLabels != 0 ? s.object : 1;
   vec4 surface = styleSurface(label);

@@ -43,10 +43,10 @@ def scaled_ijk_to_ras(spacing):
     return matrix
 
 
-def render_as_the_application(ct, spacing, iso, cut, path, place_camera, width=WIDTH):
+def render_as_the_application(ct, spacing, iso, cut, path, place_camera, width=WIDTH, occlusion=True):
     """Brightness (0..255, rows from the bottom) of one path's still frame of ct at iso with ambient occlusion on,
-    as vtkMRMLVolumeCutNode's default, and a cut field (or None); place_camera(camera) sets the view. Also the
-    window and the camera, for the depth image."""
+    as vtkMRMLVolumeCutNode's default (off where asked), and a cut field (or None); place_camera(camera) sets the
+    view. Also the window and the camera, for the depth image."""
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(1)
     window.SetSize(width, width)
@@ -58,7 +58,7 @@ def render_as_the_application(ct, spacing, iso, cut, path, place_camera, width=W
     mapper.SetRequestedRenderPath(path)
     caster = mapper.GetRayCaster()
     caster.SetIsoValue(iso)
-    caster.SetAmbientOcclusion(True)
+    caster.SetAmbientOcclusion(occlusion)
     if cut is not None:
         caster.AddCutField(cut)
     volume = vtk.vtkVolume()
