@@ -91,17 +91,6 @@ unsigned short CountSince(long before, long after)
   return static_cast<unsigned short>(std::min(std::max(after - before, 0L), 65535L));
 }
 
-double Percentile(std::vector<float> values, double percent)
-{
-  if (values.empty())
-  {
-    return 0.0;
-  }
-  const double rank = std::min(std::max(percent, 0.0), 100.0) / 100.0 * (values.size() - 1);
-  const size_t index = static_cast<size_t>(std::ceil(rank));
-  std::nth_element(values.begin(), values.begin() + index, values.end());
-  return values[index];
-}
 } // namespace
 
 /// The nerve monitor's readings of one tick, as published for the display side.
@@ -1277,7 +1266,7 @@ double vtkHapticLoop::GetTickDurationPercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.Durations.size());
-  return Percentile(std::vector<float>(internal.Durations.begin(), internal.Durations.begin() + count), percent);
+  return vtkHapticRealTime::Percentile(std::vector<float>(internal.Durations.begin(), internal.Durations.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------
@@ -1285,7 +1274,7 @@ double vtkHapticLoop::GetTickProcessorTimePercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.ProcessorDurations.size());
-  return Percentile(std::vector<float>(internal.ProcessorDurations.begin(), internal.ProcessorDurations.begin() + count), percent);
+  return vtkHapticRealTime::Percentile(std::vector<float>(internal.ProcessorDurations.begin(), internal.ProcessorDurations.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------
@@ -1299,7 +1288,7 @@ double vtkHapticLoop::GetPeriodJitterPercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.Jittered.load(std::memory_order_acquire), internal.Jitters.size());
-  return Percentile(std::vector<float>(internal.Jitters.begin(), internal.Jitters.begin() + count), percent);
+  return vtkHapticRealTime::Percentile(std::vector<float>(internal.Jitters.begin(), internal.Jitters.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------
@@ -1319,7 +1308,7 @@ double vtkHapticLoop::GetCutDurationPercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.Timed.load(std::memory_order_acquire), internal.CutDurations.size());
-  return Percentile(std::vector<float>(internal.CutDurations.begin(), internal.CutDurations.begin() + count), percent);
+  return vtkHapticRealTime::Percentile(std::vector<float>(internal.CutDurations.begin(), internal.CutDurations.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------
@@ -1358,7 +1347,7 @@ double vtkHapticLoop::GetCutterDurationPercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
   const size_t count = std::min<size_t>(internal.CutterTimed, internal.CutterDurations.size());
-  return Percentile(std::vector<float>(internal.CutterDurations.begin(), internal.CutterDurations.begin() + count), percent);
+  return vtkHapticRealTime::Percentile(std::vector<float>(internal.CutterDurations.begin(), internal.CutterDurations.begin() + count), percent);
 }
 
 //------------------------------------------------------------------------------

@@ -4,7 +4,9 @@
 
 #include "vtkVolumeCutThreadClock.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <system_error>
 #include <thread>
 
@@ -167,4 +169,17 @@ vtkHapticRealTime::Counters vtkHapticRealTime::ReadCounters()
   }
 #endif
   return counters;
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticRealTime::Percentile(std::vector<float> values, double percent)
+{
+  if (values.empty())
+  {
+    return 0.0;
+  }
+  const double rank = std::min(std::max(percent, 0.0), 100.0) / 100.0 * (values.size() - 1);
+  const size_t index = static_cast<size_t>(std::ceil(rank));
+  std::nth_element(values.begin(), values.begin() + index, values.end());
+  return values[index];
 }

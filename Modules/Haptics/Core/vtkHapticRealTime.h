@@ -25,6 +25,7 @@
 
 #include <chrono>
 #include <string>
+#include <vector>
 
 class vtkHapticRealTime
 {
@@ -70,6 +71,9 @@ public:
     long Preemptions = 0;
   };
   static Counters ReadCounters();
+
+  /// The value below which percent (0-100) of the values lie (the nearest rank above); 0 for none.
+  static double Percentile(std::vector<float> values, double percent);
 
 private:
   vtkHapticRealTime() = delete;

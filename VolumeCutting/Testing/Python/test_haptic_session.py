@@ -257,6 +257,20 @@ def test_main_job_haptics_replays_a_recorded_session_through_the_loop(tmp_path):
     assert first.ReadFile(str(tmp_path / "haptic_replay.vchr"))
     assert first.GetNumberOfTicks() == summary["ticks_run"]
 
+    # The machine's share, measured after the replay: as many ticks of constant work, the replay's mean per tick,
+    # with the views drawing as they did; slow ticks counted as the replay's are.
+    machine, profile = summary["machine_check"], summary["tick_profile"]
+    assert machine["ticks"] == summary["ticks_run"]
+    assert machine["work_us"] == pytest.approx(profile["mean_us"]["cpu_us"], rel=0.3, abs=3.0)
+    assert machine["display_frames"] == 0  # no views here: the check sleeps a display period between updates
+    assert 0 <= machine["slow_ticks_processor_bound"] <= machine["slow_ticks"] <= machine["ticks"]
+    assert machine["tick_us_p50"] <= machine["tick_us_p99"] <= machine["tick_us_max"]
+    # The force model's pace per lookup, and each slowest tick's against it.
+    assert profile["lookup_us_median"] > 0.0
+    assert profile["most_lookups_at_median_pace_us"] == pytest.approx(
+        profile["max_us"]["samples"] * profile["lookup_us_median"], rel=0.01)
+    assert all(tick["pace_ratio"] is None or tick["pace_ratio"] > 0.0 for tick in profile["slowest"])
+
 
 def test_the_haptic_thread_neither_cuts_nor_builds_shield_bricks_with_its_cutter_and_preparer(tmp_path):
     """A replay towards a protected nerve: the cutter cuts off the haptic thread, the shield is built ahead, the same cut."""
@@ -270,7 +284,8 @@ def test_the_haptic_thread_neither_cuts_nor_builds_shield_bricks_with_its_cutter
         protection.ClearBricks()
         (tmp_path / str(off_thread)).mkdir()
         summaries[off_thread] = hapticsjob.run(application, cut, plan, tmp_path / str(off_thread),
-                                               prepare_shield_ahead=off_thread, asynchronous_cutting=off_thread)
+                                               prepare_shield_ahead=off_thread, asynchronous_cutting=off_thread,
+                                               check_machine=False)
     in_ticks, off = summaries[False], summaries[True]
     assert in_ticks["protected_segments"] == off["protected_segments"] == 1
     # Cutting in the ticks without the preparer, the ticks that first reach the nerve's band build its shield themselves.

@@ -124,6 +124,16 @@ def tick_profile(loop, slowest: int = 5) -> dict:
         return {"ticks": 0}
     order = np.argsort(profiles[:, 0])[::-1][:slowest]
     slow = profiles[profiles[:, 0] > SLOW_TICK_US]
+    # The force model's pace: processor time per lookup (a CT or cut-field
+    # sample) of the ticks that made 100 or more. The same code at a pace
+    # several times slower than the run's median was slowed, not given more to do.
+    samples = profiles[:, PROFILE_FIELDS.index("samples")]
+    busy = samples >= 100
+    pace = float(np.median(profiles[busy, 1] / samples[busy])) if busy.any() else 0.0
+
+    def pace_ratio(n):
+        return round(float(profiles[n, 1] / (samples[n] * pace)), 1) if pace > 0.0 and samples[n] > 0 else None
+
     return {
         "ticks": len(profiles),
         "slow_tick_us": SLOW_TICK_US,
@@ -135,10 +145,14 @@ def tick_profile(loop, slowest: int = 5) -> dict:
         "page_faults": int(profiles[:, 6].sum()),
         "ticks_with_page_faults": int(np.sum(profiles[:, 6] > 0)),
         "preemptions": int(profiles[:, 7].sum()),
+        "lookup_us_median": round(pace, 3),
+        # The most lookups of a tick at that pace: the longest tick the force model's own work makes.
+        "most_lookups_at_median_pace_us": round(float(samples.max() * pace), 1),
+        "mean_us": {name: round(float(profiles[:, i].mean()), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "p99_us": {name: round(float(np.percentile(profiles[:, i], 99)), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "max_us": {name: round(float(profiles[:, i].max()), 1) for i, name in enumerate(PROFILE_FIELDS)},
-        "slowest": [{"tick": int(n), **{name: round(float(profiles[n, i]), 1) for i, name in enumerate(PROFILE_FIELDS)}}
-                    for n in order],
+        "slowest": [{"tick": int(n), **{name: round(float(profiles[n, i]), 1) for i, name in enumerate(PROFILE_FIELDS)},
+                     "pace_ratio": pace_ratio(n)} for n in order],
     }
 
 
@@ -182,6 +196,51 @@ def idle_loop(seconds: float = 4.5, real_time_priority: bool = True) -> dict:
     }
 
 
+def machine_check(seconds: float, work_us: float, real_time_priority: bool = True, frame=None) -> dict:
+    """What this machine gives a 1 kHz thread whose work never changes (``vtkHapticMachineCheck``).
+
+    The haptic loop's thread set-up, with ticks of ``work_us`` of arithmetic
+    each (no memory): a slow tick of it is the machine's doing, so its slow
+    ticks are the share of the loop's that the product cannot remove. A slow
+    tick whose processor time is as long was slowed without the thread
+    knowing (interrupts on its processor, a hypervisor). ``frame``, if given,
+    is called meanwhile as it was during the replay (the views render), so
+    that the conditions are the replay's.
+    """
+    check = slicer.vtkHapticMachineCheck()
+    check.SetRate(RATE_HZ)
+    check.SetDuration(float(seconds))
+    check.SetWorkTime(min(max(float(work_us), 0.0), 0.9e6 / RATE_HZ) * 1e-6)
+    check.SetSlowTickTime(SLOW_TICK_US * 1e-6)
+    check.SetRequestRealTimePriority(bool(real_time_priority))
+    if not check.Start():
+        raise RuntimeError("the machine check could not start (see the log)")
+    frames = 0
+    while check.IsRunning():
+        # As the replay's display loop: frames back to back, or a display period's sleep.
+        if frame is None:
+            time.sleep(DISPLAY_PERIOD_S)
+        else:
+            frame()
+            frames += 1
+    check.Wait()
+    return {
+        "ticks": int(check.GetNumberOfTicks()),
+        # The work a tick did: its median processor time (the calibration before the first tick may be disturbed too).
+        "work_us": round(check.GetTickProcessorTimePercentile(50.0), 1),
+        "work_us_calibrated": round(check.GetCalibratedWorkTime(), 1),
+        "display_frames": frames,
+        "tick_us_p50": round(check.GetTickDurationPercentile(50.0), 1),
+        "tick_us_p99": round(check.GetTickDurationPercentile(99.0), 1),
+        "tick_us_max": round(check.GetTickDurationPercentile(100.0), 1),
+        "tick_cpu_us_max": round(check.GetTickProcessorTimePercentile(100.0), 1),
+        "overruns": int(check.GetNumberOfOverruns()),
+        "slow_ticks": int(check.GetNumberOfSlowTicks()),
+        "slow_ticks_processor_bound": int(check.GetNumberOfProcessorBoundSlowTicks()),
+        "real_time_priority_status": check.GetRealTimePriorityStatus(),
+    }
+
+
 def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
     """The hand's input, tick by tick, as a recording a replay device reads; returns its ticks."""
     recorder = slicer.vtkHapticRecorder()
@@ -203,7 +262,8 @@ def write_recording(path: Path, direction: np.ndarray, capabilities) -> int:
 
 
 def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_ahead: bool = True, scan: dict | None = None,
-        asynchronous_cutting: bool = True, feel_pending_cuts: bool = True, real_time_priority: bool = True) -> dict:
+        asynchronous_cutting: bool = True, feel_pending_cuts: bool = True, real_time_priority: bool = True,
+        check_machine: bool = True) -> dict:
     """Record a haptic drilling session beside the cavity, replay it through the haptic path; what it did.
 
     ``frame``, if given, is called at each display frame after the session's
@@ -222,6 +282,9 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
     The replayed ticks are also saved as a complete recording
     (``haptic_session.json``, ``recording.from_haptic_ticks``) on ``scan``
     (the scan descriptor a recording names), for grading.
+    ``check_machine`` then runs :func:`machine_check` for as long, with the
+    replay's mean processor time per tick as its constant work and the same
+    display frames: its slow ticks and overruns are the machine's share.
     """
     logic = application.volume_cutting_logic
     scene = application.scene
@@ -337,6 +400,11 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         out_dir / "haptic_session.json")
     tool_pose = vtk.vtkMatrix4x4()
     tool.GetParentTransformNode().GetMatrixTransformToWorld(tool_pose)
+    profile = tick_profile(loop)
+    machine = None
+    if check_machine and profile["ticks"]:
+        machine = machine_check(loop.GetNumberOfTicks() / RATE_HZ, profile["mean_us"]["cpu_us"],
+                                real_time_priority=real_time_priority, frame=frame)
     return {
         "target": where,
         "surface_ras_mm": [round(float(v), 2) for v in surface],
@@ -381,7 +449,8 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "tick_us_max_building_shield": round(loop.GetMaximumTickDurationBuildingShield(), 1),
         "real_time_priority": bool(loop.GetRealTimePriority()),
         "real_time_priority_status": loop.GetRealTimePriorityStatus(),
-        "tick_profile": tick_profile(loop),
+        "tick_profile": profile,
+        "machine_check": machine,
         "nerve_monitor": nerve_monitor,
         "wall_s": round(wall_s, 2),
     }
