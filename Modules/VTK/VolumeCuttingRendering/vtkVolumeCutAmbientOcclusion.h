@@ -176,11 +176,8 @@ private:
     }
     for (int axis = 0; axis < 3; ++axis)
     {
-      // Index units per mm across the faces of this axis: the norm of world-to-IJK's row.
-      const double* row = scene.WorldToIJK + 4 * axis;
-      const double perMillimetre = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
       const double toFace = std::min(s.Index[axis], scene.Dimensions[axis] - 1 - s.Index[axis]);
-      depth = std::min(depth, toFace / perMillimetre);
+      depth = std::min(depth, toFace * scene.MillimetresPerIndex[axis]);
     }
     const int label = scene.HasSegments() ? s.Object : 1;
     const bool shape = scene.HasSegments() && scene.Styles[label].Shape;

@@ -203,6 +203,13 @@ void vtkVolumeCutRayCastProgram::SetUniforms(const vtkVolumeCutRayCaster::SceneV
   program->SetUniformMatrix3x3("normalMatrix", normal3);
   const float dimensions[3] = { float(dims[0]), float(dims[1]), float(dims[2]) };
   program->SetUniform3f("dimensionsF", dimensions);
+  float millimetresPerIndex[3];
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double* row = view.WorldToIJK + 4 * axis;
+    millimetresPerIndex[axis] = static_cast<float>(1.0 / std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]));
+  }
+  program->SetUniform3f("millimetresPerIndex", millimetresPerIndex);
   const float blockDimensions[3] = { float(view.BlockDimensions[0]), float(view.BlockDimensions[1]), float(view.BlockDimensions[2]) };
   program->SetUniform3f("blockDimensionsF", blockDimensions);
   const float size[2] = { float(width), float(height) };

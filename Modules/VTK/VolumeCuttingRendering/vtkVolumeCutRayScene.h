@@ -67,6 +67,9 @@ struct vtkVolumeCutRayScene
   /// Inverse transpose of IJK-to-world's linear part (4x4, row-major): maps
   /// IJK gradients to world normals.
   double NormalMatrix[16];
+  /// Millimetres per index unit across each axis's faces (1 / the norm of
+  /// world-to-IJK's row): a sample's distance to the volume's faces, once per render.
+  double MillimetresPerIndex[3] = { 1.0, 1.0, 1.0 };
 
   // Segments: the label map, fractional labelmaps and each label's style.
   std::vector<uint16_t> Labels;

@@ -67,6 +67,11 @@ const char* vtkVolumeCutSceneInputs::CopyAnatomy(
     }
   }
   scene.NormalMatrix[15] = 1.0;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const double* row = scene.WorldToIJK + 4 * axis;
+    scene.MillimetresPerIndex[axis] = 1.0 / std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+  }
   const vtkIdType count = static_cast<vtkIdType>(dims[0]) * dims[1] * dims[2];
   scene.Values.resize(count);
   const int stride = scalars->GetNumberOfComponents();

@@ -36,8 +36,7 @@ float occlusionDepth(Sample s)
   // At most the distance to the volume's faces: the material ends where the scan does.
   for (int axis = 0; axis < 3; ++axis)
   {
-    vec3 row = vec3(worldToIJK[0][axis], worldToIJK[1][axis], worldToIJK[2][axis]);
-    depth = min(depth, min(s.index[axis], float(dimensions[axis] - 1) - s.index[axis]) / length(row));
+    depth = min(depth, min(s.index[axis], float(dimensions[axis] - 1) - s.index[axis]) * millimetresPerIndex[axis]);
   }
   int label = hasLabels != 0 ? s.object : 1;
   vec4 surface = styleSurface(label);

@@ -23,6 +23,8 @@ uniform mat4 worldToNDC;
 uniform mat4 worldToIJK;
 uniform mat4 ijkToWorld;
 uniform mat3 normalMatrix;
+// Millimetres per index unit across each axis's faces (1 / the norm of world-to-IJK's row).
+uniform vec3 millimetresPerIndex;
 uniform vec2 viewportSize;
 uniform float sampleDistance;
 uniform int blendMode;
