@@ -160,6 +160,10 @@ def test_main_job_on_the_real_head_ct(tmp_path):
     summary = mainjob.run(False, tmp_path, size=(320, 240))
     assert summary["bone_segments"] == ["Cortical bone", "Trabecular bone"]
     assert summary["bone_segment_ids"] == ["CorticalBone", "TrabecularBone"]
+    # The haptic replay's slow ticks come with the machine's: a constant-work thread as long, beside the same views.
+    haptics = summary["haptics"]
+    assert haptics["machine_check"]["ticks"] == haptics["ticks_run"]
+    assert haptics["machine_check"]["display_frames"] > 0
     removed = summary["drilling"]["removed_volume_per_segment"]
     assert removed["Cortical bone"]["removed_volume_mm3"] > 100.0  # the mastoid cortex is opened
     check_outputs(summary, tmp_path)
