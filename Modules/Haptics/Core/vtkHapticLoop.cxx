@@ -784,19 +784,8 @@ bool vtkHapticLoop::RunTicks(int count)
 void vtkHapticLoop::Run()
 {
   Internals& internal = *this->Internal;
-  vtkHapticRealTime::PrepareThread();
-  if (this->RequestRealTimePriority)
-  {
-    internal.RealTime = vtkHapticRealTime::RequestPriority(this->RealTimePriorityLevel, internal.RealTimeStatus);
-  }
-  else
-  {
-    internal.RealTimeStatus = "not requested (RequestRealTimePriority is off); normal priority";
-  }
-  if (this->ProcessorIndex >= 0 && !vtkHapticRealTime::RunOnProcessor(this->ProcessorIndex))
-  {
-    internal.RealTimeStatus += "; processor " + std::to_string(this->ProcessorIndex) + " refused";
-  }
+  internal.RealTime = vtkHapticRealTime::SetUpServoThread(
+    this->RequestRealTimePriority, this->RealTimePriorityLevel, this->ProcessorIndex, internal.RealTimeStatus);
   internal.ThreadReady.store(true, std::memory_order_release);
   const Clock::duration period =
     std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / this->Rate));

@@ -170,19 +170,8 @@ void vtkHapticMachineCheck::Measure()
 {
   using Clock = vtkHapticRealTime::Clock;
   Internals& internal = *this->Internal;
-  vtkHapticRealTime::PrepareThread();
-  if (this->RequestRealTimePriority)
-  {
-    internal.RealTime = vtkHapticRealTime::RequestPriority(this->RealTimePriorityLevel, internal.RealTimeStatus);
-  }
-  else
-  {
-    internal.RealTimeStatus = "not requested (RequestRealTimePriority is off); normal priority";
-  }
-  if (this->ProcessorIndex >= 0 && !vtkHapticRealTime::RunOnProcessor(this->ProcessorIndex))
-  {
-    internal.RealTimeStatus += "; processor " + std::to_string(this->ProcessorIndex) + " refused";
-  }
+  internal.RealTime = vtkHapticRealTime::SetUpServoThread(
+    this->RequestRealTimePriority, this->RealTimePriorityLevel, this->ProcessorIndex, internal.RealTimeStatus);
   // Calibrated where the ticks run: same thread, same priority, same processor.
   const long long iterations = CalibrateWork(this->WorkTime * 1e6, internal.CalibratedWork, internal.Sink);
   const Clock::duration period =

@@ -99,6 +99,26 @@ bool vtkHapticRealTime::RequestPriority(int level, std::string& status)
 }
 
 //------------------------------------------------------------------------------
+bool vtkHapticRealTime::SetUpServoThread(bool requestPriority, int level, int processor, std::string& status)
+{
+  PrepareThread();
+  bool realTime = false;
+  if (requestPriority)
+  {
+    realTime = RequestPriority(level, status);
+  }
+  else
+  {
+    status = "not requested (RequestRealTimePriority is off); normal priority";
+  }
+  if (processor >= 0 && !RunOnProcessor(processor))
+  {
+    status += "; processor " + std::to_string(processor) + " refused";
+  }
+  return realTime;
+}
+
+//------------------------------------------------------------------------------
 bool vtkHapticRealTime::RunOnProcessor(int index)
 {
 #if defined(__linux__)

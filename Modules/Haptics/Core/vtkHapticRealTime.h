@@ -40,6 +40,14 @@ public:
    */
   static bool RequestPriority(int level, std::string& status);
 
+  /**
+   * What a servo thread does before its first tick: PrepareThread, then
+   * RequestPriority at level if requestPriority (else status says it was
+   * not requested), then RunOnProcessor if processor >= 0 (a refusal is
+   * added to status). Returns whether the thread got real-time priority.
+   */
+  static bool SetUpServoThread(bool requestPriority, int level, int processor, std::string& status);
+
   /// Restrict the calling thread to one processor; false if refused or out of range.
   static bool RunOnProcessor(int index);
 
