@@ -4,6 +4,7 @@
 
 #include "vtkHapticRealTime.h"
 
+#include "vtkDoubleArray.h"
 #include "vtkObjectFactory.h"
 
 #include <algorithm>
@@ -34,14 +35,9 @@ double ConstantWork(long long iterations, double seed)
   return value;
 }
 
-/// Iterations of ConstantWork that take this many microseconds of the calling thread's processor time.
-long long CalibrateWork(double microseconds, double& measured, volatile double& sink)
+/// Iterations of ConstantWork per microsecond of the calling thread's processor time.
+double IterationsPerMicrosecond(volatile double& sink)
 {
-  if (microseconds <= 0.0)
-  {
-    measured = 0.0;
-    return 0;
-  }
   // The fastest of several runs: a run the machine slowed would give too few iterations.
   constexpr long long probe = 20000;
   double fastest = 0.0;
@@ -55,8 +51,16 @@ long long CalibrateWork(double microseconds, double& measured, volatile double& 
       fastest = elapsed;
     }
   }
-  const long long iterations = std::max<long long>(1, static_cast<long long>(microseconds / std::max(fastest, 1e-3) * probe));
-  // What the work takes now, as the ticks will do it: the median of a few runs.
+  return probe / std::max(fastest, 1e-3);
+}
+
+/// What this many iterations take now, as the ticks will do them: the median of a few runs (us).
+double MeasureWork(long long iterations, volatile double& sink)
+{
+  if (iterations <= 0)
+  {
+    return 0.0;
+  }
   std::vector<double> runs;
   for (int run = 0; run < 9; ++run)
   {
@@ -65,8 +69,7 @@ long long CalibrateWork(double microseconds, double& measured, volatile double& 
     runs.push_back(vtkHapticRealTime::ThreadProcessorMicroseconds() - start);
   }
   std::nth_element(runs.begin(), runs.begin() + runs.size() / 2, runs.end());
-  measured = runs[runs.size() / 2];
-  return iterations;
+  return runs[runs.size() / 2];
 }
 } // namespace
 
@@ -75,6 +78,8 @@ struct vtkHapticMachineCheck::Internals
   std::vector<float> Durations;
   std::vector<float> ProcessorTimes;
   size_t Ticks = 0;
+  /// Each tick's work (s), cycled: WorkTimes copied at Start, or WorkTime alone.
+  std::vector<double> Work;
   vtkIdType Overruns = 0;
   double CalibratedWork = 0.0;
   bool RealTime = false;
@@ -94,7 +99,11 @@ vtkHapticMachineCheck::vtkHapticMachineCheck()
 vtkHapticMachineCheck::~vtkHapticMachineCheck()
 {
   this->Wait();
+  this->SetWorkTimes(nullptr);
 }
+
+//------------------------------------------------------------------------------
+vtkCxxSetObjectMacro(vtkHapticMachineCheck, WorkTimes, vtkDoubleArray);
 
 //------------------------------------------------------------------------------
 bool vtkHapticMachineCheck::Start()
@@ -112,11 +121,24 @@ bool vtkHapticMachineCheck::Start()
   internal.CalibratedWork = 0.0;
   internal.RealTime = false;
   internal.RealTimeStatus = "not run";
-  if (this->WorkTime > 0.9 / this->Rate)
+  internal.Work.assign(1, this->WorkTime);
+  if (this->WorkTimes && this->WorkTimes->GetNumberOfTuples() > 0)
   {
-    vtkErrorMacro("Start: " << this->WorkTime * 1e6 << " us of work does not fit in a period of " << 1e6 / this->Rate
-                            << " us (at most 0.9 of it)");
-    return false;
+    internal.Work.resize(static_cast<size_t>(this->WorkTimes->GetNumberOfTuples()));
+    for (vtkIdType n = 0; n < this->WorkTimes->GetNumberOfTuples(); ++n)
+    {
+      internal.Work[n] = this->WorkTimes->GetValue(n);
+    }
+  }
+  for (const double work : internal.Work)
+  {
+    if (!(work >= 0.0 && work <= 0.9 / this->Rate))
+    {
+      vtkErrorMacro("Start: " << work * 1e6 << " us of work does not fit in a period of " << 1e6 / this->Rate
+                              << " us (0 to 0.9 of it)");
+      internal.Work.clear();
+      return false;
+    }
   }
   internal.Ticks = static_cast<size_t>(this->Duration * this->Rate + 0.5);
   // Allocated here: the ticks only store into it.
@@ -173,7 +195,15 @@ void vtkHapticMachineCheck::Measure()
   internal.RealTime = vtkHapticRealTime::SetUpServoThread(
     this->RequestRealTimePriority, this->RealTimePriorityLevel, this->ProcessorIndex, internal.RealTimeStatus);
   // Calibrated where the ticks run: same thread, same priority, same processor.
-  const long long iterations = CalibrateWork(this->WorkTime * 1e6, internal.CalibratedWork, internal.Sink);
+  const double perMicrosecond = IterationsPerMicrosecond(internal.Sink);
+  std::vector<long long> iterations(internal.Work.size());
+  double total = 0.0;
+  for (size_t n = 0; n < iterations.size(); ++n)
+  {
+    iterations[n] = static_cast<long long>(internal.Work[n] * 1e6 * perMicrosecond + 0.5);
+    total += iterations[n];
+  }
+  internal.CalibratedWork = MeasureWork(static_cast<long long>(total / iterations.size() + 0.5), internal.Sink);
   const Clock::duration period =
     std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / this->Rate));
   const Clock::duration spin = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(this->SpinTime));
@@ -184,7 +214,7 @@ void vtkHapticMachineCheck::Measure()
     // As the loop measures a tick: processor time read inside the wall-clock interval.
     const Clock::time_point start = Clock::now();
     const double processorStart = vtkHapticRealTime::ThreadProcessorMicroseconds();
-    internal.Sink = ConstantWork(iterations, internal.Sink);
+    internal.Sink = ConstantWork(iterations[tick % iterations.size()], internal.Sink);
     const double processorEnd = vtkHapticRealTime::ThreadProcessorMicroseconds();
     const Clock::time_point end = Clock::now();
     internal.Durations.push_back(std::chrono::duration<float, std::micro>(end - start).count());
@@ -278,6 +308,7 @@ void vtkHapticMachineCheck::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Rate: " << this->Rate << " Hz\n";
   os << indent << "Duration: " << this->Duration << " s\n";
   os << indent << "WorkTime: " << this->WorkTime << " s (calibrated: " << this->GetCalibratedWorkTime() << " us)\n";
+  os << indent << "WorkTimes: " << (this->WorkTimes ? this->WorkTimes->GetNumberOfTuples() : 0) << " ticks\n";
   os << indent << "SlowTickTime: " << this->SlowTickTime << " s\n";
   os << indent << "RequestRealTimePriority: " << (this->RequestRealTimePriority ? "on" : "off") << " (level "
      << this->RealTimePriorityLevel << "): " << this->Internal->RealTimeStatus << "\n";

@@ -13,9 +13,9 @@
  *
  * The check does what the haptic loop's thread does (vtkHapticLoop: the same
  * real-time priority, resident stack, sleeps to absolute deadlines and wait
- * before each), but every tick does the same arithmetic for WorkTime
- * seconds of processor time (measured on the thread before its first tick)
- * and reads no memory. Whatever makes one of its ticks slower than
+ * before each), but its ticks do arithmetic only, reading no memory: each
+ * for WorkTime seconds of processor time, or for its own of WorkTimes (a
+ * loop's ticks, one by one), as calibrated on the thread before the first. Whatever makes one of its ticks slower than
  * SlowTickTime, or late, is the machine's: compared with the loop's own
  * slow ticks over the same time and work, it tells the product's stalls
  * from the machine's (cyclictest's question, asked with work in the tick).
@@ -32,6 +32,8 @@
 #include "vtkVolumeCuttingHapticsExport.h" // For export macro
 
 #include <memory> // For the internals
+
+class vtkDoubleArray;
 
 class VTK_VOLUMECUTTINGHAPTICS_EXPORT vtkHapticMachineCheck : public vtkObject
 {
@@ -60,6 +62,17 @@ public:
   ///@}
 
   ///@{
+  /**
+   * Each tick's work instead, in seconds (one value per tick, cycled): a
+   * loop's own sequence of processor times per tick, so that the check
+   * does the same work tick by tick. Copied at Start; none (the default)
+   * or an empty array: WorkTime for every tick.
+   */
+  virtual void SetWorkTimes(vtkDoubleArray* seconds);
+  vtkGetObjectMacro(WorkTimes, vtkDoubleArray);
+  ///@}
+
+  ///@{
   /// A tick longer than this (seconds, wall clock) is slow (500 us by
   /// default: half the 1 kHz period, the haptic loop's target).
   vtkSetClampMacro(SlowTickTime, double, 1e-6, 1.0);
@@ -84,7 +97,7 @@ public:
    * so that the caller can go on with what it would do beside a haptic
    * loop (render, say), which makes the check's conditions the loop's.
    * False, with an error, if a check is running, the settings leave no
-   * time for the work (WorkTime over 0.9 of the period) or the thread
+   * time for the work (a WorkTime or WorkTimes value over 0.9 of the period) or the thread
    * cannot start; the statistics are then empty.
    */
   bool Start();
@@ -120,7 +133,7 @@ public:
    */
   vtkIdType GetNumberOfProcessorBoundSlowTicks() const;
 
-  /// Processor time the work took in the calibration before the first tick, in microseconds (WorkTime, as measured).
+  /// Processor time of the ticks' mean work as measured before the first tick, in microseconds.
   double GetCalibratedWorkTime() const;
 
   ///@{
@@ -141,6 +154,7 @@ protected:
   int RealTimePriorityLevel = 80;
   double SpinTime = 0.0002;
   int ProcessorIndex = -1;
+  vtkDoubleArray* WorkTimes = nullptr;
 
 private:
   vtkHapticMachineCheck(const vtkHapticMachineCheck&) = delete;

@@ -4,11 +4,14 @@
 // asked for (calibrated on its thread, so neither optimised away nor a
 // multiple of it), counts slow and processor-bound ticks by its threshold,
 // asks for real-time priority as the loop does (or says it was not asked),
-// and refuses work that does not fit in a period, leaving nothing measured.
+// runs beside its caller (Start, Wait) and refuses a second start, does a
+// sequence of work per tick (a loop's own, cycled), and refuses work that
+// does not fit in a period, leaving nothing measured.
 #include "vtkHapticMachineCheck.h"
 
 #include <vtkAddonTestingMacros.h>
 
+#include <vtkDoubleArray.h>
 #include <vtkNew.h>
 
 #include <cstring>
@@ -75,6 +78,27 @@ int vtkHapticMachineCheckTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   TESTING_OUTPUT_ASSERT_ERRORS_END();
   CHECK_INT(static_cast<int>(check->GetNumberOfTicks()), 0);
   CHECK_DOUBLE(check->GetTickDurationPercentile(100.0), 0.0);
+
+  // A sequence of work per tick, cycled: ticks of 20 and 300 us in turn take about that much processor time each.
+  vtkNew<vtkDoubleArray> sequence;
+  sequence->InsertNextValue(20e-6);
+  sequence->InsertNextValue(300e-6);
+  check->SetWorkTimes(sequence);
+  check->SetRequestRealTimePriority(true);
+  check->SetDuration(0.2);
+  check->SetSlowTickTime(150e-6);
+  CHECK_BOOL(check->Run(), true);
+  CHECK_INT(static_cast<int>(check->GetNumberOfTicks()), 200);
+  // The mean work (160 us) as calibrated; half the ticks over 150 us of processor time, bound by their work.
+  CHECK_BOOL(check->GetCalibratedWorkTime() > 110.0 && check->GetCalibratedWorkTime() < 480.0, true);
+  CHECK_BOOL(check->GetNumberOfProcessorBoundSlowTicks() >= 95 && check->GetNumberOfSlowTicks() <= 130, true);
+  CHECK_BOOL(check->GetTickProcessorTimePercentile(25.0) < 100.0, true);
+  // A value that does not fit in a period is refused like WorkTime.
+  sequence->InsertNextValue(0.002);
+  TESTING_OUTPUT_ASSERT_ERRORS_BEGIN();
+  CHECK_BOOL(check->Run(), false);
+  TESTING_OUTPUT_ASSERT_ERRORS_END();
+  CHECK_INT(static_cast<int>(check->GetNumberOfTicks()), 0);
 
   std::ostringstream printed;
   check->Print(printed);

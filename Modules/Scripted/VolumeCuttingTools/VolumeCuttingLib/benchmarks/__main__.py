@@ -26,6 +26,7 @@ AREAS = {
     "gpuprogram": ("gpuprogram", "gpuprogram"),
     "workflow": ("workflow", "workflow"),
     "haptics": ("haptics", "haptics"),
+    "hapticsmachine": ("hapticsmachine", "hapticsmachine"),
     "interactive": ("interactive", "interactive"),
     "sliceview": ("sliceview", "sliceview"),
     "softcut": ("softcut", "softcut_area"),

@@ -563,13 +563,13 @@ def main(argv=None) -> int:
         print(f"note: the haptic loop ran at normal priority: {haptics.get('real_time_priority_status')}", file=sys.stderr)
     machine = haptics.get("machine_check") if haptics else None
     if machine and haptics.get("overruns"):
-        # Overruns alone do not say whose they are: beside them, what a thread of constant work got on this machine.
+        # Overruns alone do not say whose they are: beside them, what the same work got on this machine without the product's code.
         profile = haptics["tick_profile"]
         print(f"note: the haptic loop overran {haptics['overruns']} times ({profile['slow_ticks']} ticks over "
-              f"{profile['slow_tick_us']:.0f} us, {profile['slow_ticks_processor_bound']} processor-bound); a thread of "
-              f"constant work ({machine['work_us']:.0f} us a tick) beside the same views overran {machine['overruns']} "
+              f"{profile['slow_tick_us']:.0f} us, {profile['slow_ticks_processor_bound']} processor-bound); a thread doing "
+              f"the same work, tick by tick, without memory, beside the same views overran {machine['overruns']} "
               f"times ({machine['slow_ticks']} over, {machine['slow_ticks_processor_bound']} processor-bound): "
-              f"what this machine does to a thread whose work never changes", file=sys.stderr)
+              f"what this machine does to that work alone", file=sys.stderr)
     return 0 if summary["inputs_ok"] else 1
 
 
