@@ -22,6 +22,14 @@ vtkStandardNewMacro(vtkHapticForceModel);
 
 namespace
 {
+/// The cut field's lookups this thread made (RemovalDistance): Contact
+/// counts its own as the difference. Per thread, as the force model's const
+/// queries may run on several threads at once.
+thread_local unsigned long long CutFieldLookups = 0;
+} // namespace
+
+namespace
+{
 /// The renderer's trilinear interpolation (vtkVolumeCutRayCaster keeps the
 /// CT as float and blends in double): the same arithmetic, the same surface.
 template <typename T>
@@ -364,7 +372,12 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
 double vtkHapticForceModel::RemovalDistance(const double ras[3], bool pending) const
 {
   const Internals& internal = *this->Internal;
-  double removal = this->CutField ? this->CutField->GetSignedDistance(ras) : VTK_DOUBLE_MAX;
+  double removal = VTK_DOUBLE_MAX;
+  if (this->CutField)
+  {
+    ++CutFieldLookups;
+    removal = this->CutField->GetSignedDistance(ras);
+  }
   if (!pending)
   {
     return removal;
@@ -590,6 +603,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
 int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3], bool record, ContactWork* work) const
 {
   int looked = 0;
+  const unsigned long long cutFieldLookupsBefore = CutFieldLookups;
   double deepest = 0.0;
   const Internals& internal = *this->Internal;
   // Only the haptic thread's Update records: ComputeContactForce stays a pure read.
@@ -648,6 +662,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
   if (work)
   {
     work->Samples += looked;
+    work->CutFieldSamples += static_cast<int>(CutFieldLookups - cutFieldLookupsBefore);
     work->Deepest = deepest;
   }
   return contacts;
@@ -746,6 +761,7 @@ void vtkHapticForceModel::Update(const double position[3], const double rotation
     ContactWork work;
     contacts = this->Contact(x, rotation, contact, true, &work);
     result.NumberOfSamples += work.Samples;
+    result.NumberOfCutFieldSamples += work.CutFieldSamples;
     result.Immersion = work.Deepest;
     ++result.NumberOfProxySteps;
     double move[3];

@@ -282,6 +282,8 @@ public:
     /// Points of the anatomy the tick's contact tests looked up (CT and
     /// cut field), traces included: what the tick's work grows with.
     int NumberOfSamples;
+    /// Of those, the cut field's lookups (the costlier kind: curvature-corrected distances).
+    int NumberOfCutFieldSamples;
     /// The deepest shell point's depth in material (mm) at the last contact test.
     double Immersion;
   };
@@ -340,6 +342,7 @@ protected:
   struct ContactWork
   {
     int Samples = 0;
+    int CutFieldSamples = 0;
     double Deepest = 0.0;
   };
   int Contact(const double position[3], const double rotation[3][3], double force[3], bool record = false, ContactWork* work = nullptr) const;

@@ -164,6 +164,7 @@ struct vtkHapticLoop::Internals
   {
     int Contacts, ProxySteps, Samples;
     float Immersion;
+    int CutFieldSamples;
   };
   std::vector<ModelWork> Work;
   unsigned long long ShieldBricksInTicks = 0;
@@ -1039,7 +1040,8 @@ void vtkHapticLoop::Tick(double timeStep)
   }
   internal.Model->Update(position, rotation, timeStep, drilling, result);
   internal.ModelDurations[slot] = std::chrono::duration<float, std::micro>(Clock::now() - modelStart).count();
-  internal.Work[slot] = { result.NumberOfContacts, result.NumberOfProxySteps, result.NumberOfSamples, static_cast<float>(result.Immersion) };
+  internal.Work[slot] = { result.NumberOfContacts, result.NumberOfProxySteps, result.NumberOfSamples, static_cast<float>(result.Immersion),
+    result.NumberOfCutFieldSamples };
 
   bool cut = false;
   if (drilling && result.Cut)
@@ -1353,9 +1355,9 @@ int vtkHapticLoop::GetNumberOfKeptTicks() const
 }
 
 //------------------------------------------------------------------------------
-bool vtkHapticLoop::GetTickProfile(int index, double profile[12]) const
+bool vtkHapticLoop::GetTickProfile(int index, double profile[13]) const
 {
-  static_assert(NumberOfTickProfileFields == 12, "the profile's array holds every field");
+  static_assert(NumberOfTickProfileFields == 13, "the profile's array holds every field");
   const Internals& internal = *this->Internal;
   if (index < 0 || index >= this->GetNumberOfKeptTicks())
   {
@@ -1378,6 +1380,7 @@ bool vtkHapticLoop::GetTickProfile(int index, double profile[12]) const
   profile[ProfileProxySteps] = work.ProxySteps;
   profile[ProfileSamples] = work.Samples;
   profile[ProfileImmersion] = work.Immersion;
+  profile[ProfileCutFieldSamples] = work.CutFieldSamples;
   return true;
 }
 

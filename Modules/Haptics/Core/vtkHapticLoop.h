@@ -414,6 +414,8 @@ public:
     ProfileProxySteps,
     ProfileSamples,
     ProfileImmersion,
+    /// Of the points looked up, the cut field's (costlier: curvature-corrected distances).
+    ProfileCutFieldSamples,
     NumberOfTickProfileFields
   };
 
@@ -425,7 +427,7 @@ public:
    * and preemptions was the system's, one with page faults touched new memory,
    * one with many samples had the force model trace deep contacts.
    */
-  bool GetTickProfile(int index, double profile[12]) const;
+  bool GetTickProfile(int index, double profile[13]) const;
   int GetNumberOfKeptTicks() const;
 
 protected:

@@ -271,6 +271,11 @@ def test_main_job_haptics_replays_a_recorded_session_through_the_loop(tmp_path):
     assert profile["most_lookups_at_median_pace_us"] == pytest.approx(
         profile["max_us"]["samples"] * profile["lookup_us_median"], rel=0.01)
     assert all(tick["pace_ratio"] is None or tick["pace_ratio"] > 0.0 for tick in profile["slowest"])
+    # The lookups by kind: the cut field's among them once the burr has cut, each costlier than a CT-only one.
+    assert 0 < profile["max_us"]["cut_samples"] <= profile["max_us"]["samples"]
+    fixed, per_ct, per_cut = profile["own_work_fit_us"]
+    assert per_cut > 0.0 and profile["longest_own_work_us"] > 0.0
+    assert all(tick["own_work_us"] is not None for tick in profile["slowest"])
 
 
 def test_the_haptic_thread_neither_cuts_nor_builds_shield_bricks_with_its_cutter_and_preparer(tmp_path):

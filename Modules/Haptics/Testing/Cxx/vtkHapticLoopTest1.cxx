@@ -221,6 +221,7 @@ int vtkHapticLoopTest1(int argc, char* argv[])
   int cuttingTicks = 0;
   int contactTicks = 0;
   int overfull = 0;
+  int cutFieldTicks = 0;
   for (int n = 0; n < loop->GetNumberOfKeptTicks(); ++n)
   {
     CHECK_BOOL(loop->GetTickProfile(n, profile), true);
@@ -236,8 +237,13 @@ int vtkHapticLoopTest1(int argc, char* argv[])
     CHECK_BOOL(profile[vtkHapticLoop::ProfileContacts] <= 82.0, true);
     CHECK_BOOL(profile[vtkHapticLoop::ProfileImmersion] >= 0.0 && profile[vtkHapticLoop::ProfileImmersion] <= 2.5, true);
     contactTicks += profile[vtkHapticLoop::ProfileContacts] > 0.0 && profile[vtkHapticLoop::ProfileImmersion] > 0.0 ? 1 : 0;
+    // Of the points looked up, the cut field's: where the CT is solid, once the burr has cut.
+    CHECK_BOOL(profile[vtkHapticLoop::ProfileCutFieldSamples] >= 0.0 &&
+        profile[vtkHapticLoop::ProfileCutFieldSamples] <= profile[vtkHapticLoop::ProfileSamples], true);
+    cutFieldTicks += profile[vtkHapticLoop::ProfileCutFieldSamples] > 0.0 ? 1 : 0;
   }
   CHECK_INT(overfull, 0);
+  CHECK_BOOL(cutFieldTicks > 0 && cutFieldTicks >= cuttingTicks / 2, true);
   CHECK_BOOL(contactTicks >= cuttingTicks, true);
   std::cout << cuttingTicks << " of " << recorded << " ticks cut" << std::endl;
   CHECK_BOOL(cuttingTicks > 100, true);

@@ -13,7 +13,9 @@ as arithmetic (no memory; the slowest 1 % cut to the 99th percentile) while
 the view draws as before: the check's slow ticks and overruns are the
 machine's alone, the baseline of the loop's. The force
 model's own longest work is the most lookups of any tick at the run's median
-pace per lookup (``tick_profile``'s ``most_lookups_at_median_pace_us``).
+pace per lookup (``tick_profile``'s ``most_lookups_at_median_pace_us``), and
+by a fit of each tick's processor time to its CT-only and cut-field lookups
+over the ticks the machine left alone (``longest_own_work_us``).
 """
 
 from __future__ import annotations
@@ -66,7 +68,8 @@ def hapticsmachine(repeats: int) -> list[dict]:
     row["processor_bound"] = {"loop": sum(p["slow_ticks_processor_bound"] for p in profiles),
                               "same_work": sum(c["slow_ticks_processor_bound"] for c in checks)}
     # The loop's slow ticks at their pace: several times the median pace is the same work slowed.
-    row["loop_slow_ticks"] = [{key: tick[key] for key in ("tick_us", "cpu_us", "samples", "pace_ratio", "preemptions")}
+    row["loop_slow_ticks"] = [{key: tick[key] for key in ("tick_us", "cpu_us", "samples", "cut_samples", "pace_ratio", "own_work_us",
+                                                  "preemptions")}
                               for p in profiles for tick in p["slowest"] if tick["tick_us"] > hapticsjob.SLOW_TICK_US]
     row["work_us_mean"] = [c["work_us_mean_calibrated"] for c in checks]
     row["host_steal_ms"] = [round(ms, 1) for ms in stolen]
@@ -83,6 +86,9 @@ def hapticsmachine(repeats: int) -> list[dict]:
                       "issue 28's target for the longest tick", hapticsjob.SLOW_TICK_US, ticks, machine)
     row["median_pace_us_per_lookup"] = [p["lookup_us_median"] for p in profiles]
     row["most_lookups"] = [p["max_us"]["samples"] for p in profiles]
+    # By kind of lookup (fixed, per CT-only, per cut-field lookup, fitted on the ticks the machine left alone).
+    row["own_work_fit_us"] = [p["own_work_fit_us"] for p in profiles]
+    row["longest_own_work_us_by_fit"] = [p["longest_own_work_us"] for p in profiles]
     results.append(row)
     for row in results:
         row["tick_us_p99"] = [r["tick_us_p99"] for r in replays]

@@ -103,7 +103,8 @@ def active_burr(scene, cut_node):
 SLOW_TICK_US = 500.0
 #: The parts of a tick's profile, in ``vtkHapticLoop.GetTickProfile``'s order.
 PROFILE_FIELDS = ("tick_us", "cpu_us", "force_model_us", "cut_us", "nerve_monitor_us", "shield_bricks_built",
-                  "page_faults", "preemptions", "contacts", "proxy_steps", "samples", "immersion_um")
+                  "page_faults", "preemptions", "contacts", "proxy_steps", "samples", "immersion_um",
+                  "cut_samples")
 
 
 def kept_tick_profiles(loop) -> np.ndarray:
@@ -140,6 +141,17 @@ def tick_profile(loop, slowest: int = 5) -> dict:
     def pace_ratio(n):
         return round(float(profiles[n, 1] / (samples[n] * pace)), 1) if pace > 0.0 and samples[n] > 0 else None
 
+    # The tick's own work by kind of lookup: processor time ~ fixed + per CT-only lookup + per cut-field lookup,
+    # fitted on the ticks the machine left alone (under the slow threshold and the 99th percentile), so that a
+    # slow tick's time can be set against what its own lookups take.
+    cut_samples = profiles[:, PROFILE_FIELDS.index("cut_samples")]
+    kinds = np.c_[np.ones(len(profiles)), samples - cut_samples, cut_samples]
+    calm = (profiles[:, 0] <= SLOW_TICK_US) & (profiles[:, 1] <= np.percentile(profiles[:, 1], 99.0))
+    own = None
+    if calm.sum() >= 10:
+        coefficients = np.linalg.lstsq(kinds[calm], profiles[calm, 1], rcond=None)[0]
+        own = kinds @ coefficients
+
     return {
         "ticks": len(profiles),
         "slow_tick_us": SLOW_TICK_US,
@@ -154,12 +166,16 @@ def tick_profile(loop, slowest: int = 5) -> dict:
         "lookup_us_median": round(pace, 3),
         # The most lookups of a tick at that pace: the longest tick the force model's own work makes.
         "most_lookups_at_median_pace_us": round(float(samples.max() * pace), 1),
+        # The fit by kind of lookup (us: per tick, per CT-only lookup, per cut-field lookup) and the longest own work.
+        "own_work_fit_us": None if own is None else [round(float(c), 3) for c in coefficients],
+        "longest_own_work_us": None if own is None else round(float(own.max()), 1),
         "p50_us": {name: round(float(np.percentile(profiles[:, i], 50)), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "mean_us": {name: round(float(profiles[:, i].mean()), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "p99_us": {name: round(float(np.percentile(profiles[:, i], 99)), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "max_us": {name: round(float(profiles[:, i].max()), 1) for i, name in enumerate(PROFILE_FIELDS)},
         "slowest": [{"tick": int(n), **{name: round(float(profiles[n, i]), 1) for i, name in enumerate(PROFILE_FIELDS)},
-                     "pace_ratio": pace_ratio(n)} for n in order],
+                     "pace_ratio": pace_ratio(n),
+                     "own_work_us": None if own is None else round(float(own[n]), 1)} for n in order],
     }
 
 
