@@ -22,14 +22,6 @@ vtkStandardNewMacro(vtkHapticForceModel);
 
 namespace
 {
-/// The cut field's lookups this thread made (RemovalDistance): Contact
-/// counts its own as the difference. Per thread, as the force model's const
-/// queries may run on several threads at once.
-thread_local unsigned long long CutFieldLookups = 0;
-} // namespace
-
-namespace
-{
 /// The renderer's trilinear interpolation (vtkVolumeCutRayCaster keeps the
 /// CT as float and blends in double): the same arithmetic, the same surface.
 template <typename T>
@@ -348,6 +340,7 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
   margins.Anatomy = -1.0;
   margins.Removal = VTK_DOUBLE_MAX;
   margins.InBox = false;
+  margins.CutLookedUp = false;
   double ijk[3];
   for (int row = 0; row < 3; ++row)
   {
@@ -365,6 +358,7 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
   if (withCut && (this->CutField || pending) && !(margins.Anatomy < 0.0))
   {
     margins.Removal = this->RemovalDistance(ras, pending);
+    margins.CutLookedUp = this->CutField != nullptr;
   }
 }
 
@@ -372,12 +366,7 @@ void vtkHapticForceModel::Measure(const double ras[3], Margins& margins, bool wi
 double vtkHapticForceModel::RemovalDistance(const double ras[3], bool pending) const
 {
   const Internals& internal = *this->Internal;
-  double removal = VTK_DOUBLE_MAX;
-  if (this->CutField)
-  {
-    ++CutFieldLookups;
-    removal = this->CutField->GetSignedDistance(ras);
-  }
+  double removal = this->CutField ? this->CutField->GetSignedDistance(ras) : VTK_DOUBLE_MAX;
   if (!pending)
   {
     return removal;
@@ -492,7 +481,8 @@ double FindBorder(Margin&& margin, double a, double marginA, double b, double ma
 } // namespace
 
 //------------------------------------------------------------------------------
-double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples, bool pending) const
+double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples,
+  int& cutSamples, bool pending) const
 {
   const double step = this->Internal->TraceStep;
   // 1/256 of a step (a step is half a voxel): far inside the 0.1 voxel the
@@ -526,6 +516,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
     at(t, q);
     Margins here;
     this->Measure(q, here, t >= cutFree, pending);
+    cutSamples += here.CutLookedUp;
     if (!here.IsSolid())
     {
       if (!here.InBox)
@@ -540,6 +531,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
           at(middle, m);
           Margins margins;
           this->Measure(m, margins, true, pending);
+          cutSamples += margins.CutLookedUp;
           (margins.IsSolid() ? inside : outside) = middle;
         }
         return 0.5 * (inside + outside);
@@ -564,6 +556,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         double m[3];
         at(exit - tolerance, m);
         here.Removal = this->RemovalDistance(m, pending);
+        cutSamples += this->CutField != nullptr;
         if (!(here.Removal < 0.0))
         {
           return exit;
@@ -578,6 +571,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
         [&](double s) {
           double m[3];
           at(s, m);
+          cutSamples += this->CutField != nullptr;
           return this->RemovalDistance(m, pending);
         },
         measured, measuredRemoval, end, here.Removal, tolerance);
@@ -603,7 +597,7 @@ double vtkHapticForceModel::ExitDistance(const double p[3], const double u[3], d
 int vtkHapticForceModel::Contact(const double position[3], const double rotation[3][3], double force[3], bool record, ContactWork* work) const
 {
   int looked = 0;
-  const unsigned long long cutFieldLookupsBefore = CutFieldLookups;
+  int cutLooked = 0;
   double deepest = 0.0;
   const Internals& internal = *this->Internal;
   // Only the haptic thread's Update records: ComputeContactForce stays a pure read.
@@ -627,6 +621,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
     Margins margins;
     this->Measure(p, margins, true, pending);
     ++looked;
+    cutLooked += margins.CutLookedUp;
     if (!margins.IsSolid())
     {
       // A point in the cut is at least the cut field's distance from the
@@ -647,7 +642,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
       continue;
     }
     const double u[3] = { -offset[0] / length, -offset[1] / length, -offset[2] / length };
-    const double depth = this->ExitDistance(p, u, length, margins, looked, pending);
+    const double depth = this->ExitDistance(p, u, length, margins, looked, cutLooked, pending);
     deepest = std::max(deepest, depth);
     for (int axis = 0; axis < 3; ++axis)
     {
@@ -662,7 +657,7 @@ int vtkHapticForceModel::Contact(const double position[3], const double rotation
   if (work)
   {
     work->Samples += looked;
-    work->CutFieldSamples += static_cast<int>(CutFieldLookups - cutFieldLookupsBefore);
+    work->CutFieldSamples += cutLooked;
     work->Deepest = deepest;
   }
   return contacts;

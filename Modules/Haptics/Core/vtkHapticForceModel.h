@@ -355,6 +355,7 @@ protected:
     double Anatomy;  ///< CT less the iso-value (solid when not negative)
     double Removal;  ///< the cut field's signed distance (mm; removed when negative), measured only where the CT is solid
     bool InBox;      ///< inside the CT's box
+    bool CutLookedUp; ///< whether the cut field was looked up (the costlier lookup)
     bool IsSolid() const { return this->InBox && !(this->Anatomy < 0.0) && !(this->Removal < 0.0); }
   };
   /// withCut false leaves the cut field out (Removal stays the largest double);
@@ -364,7 +365,8 @@ protected:
   double RemovalDistance(const double ras[3], bool pending) const;
   /// Distance from p (in material, with its margins) along unit u to where the material ends, at most length;
   /// adds the points it looked up to samples.
-  double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples, bool pending) const;
+  double ExitDistance(const double p[3], const double u[3], double length, const Margins& atStart, int& samples, int& cutSamples,
+    bool pending) const;
 
   vtkSmartPointer<vtkImageData> Anatomy;
   vtkSmartPointer<vtkMatrix4x4> AnatomyIJKToRAS;

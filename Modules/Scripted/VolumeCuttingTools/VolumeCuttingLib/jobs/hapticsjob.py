@@ -117,14 +117,15 @@ def kept_tick_profiles(loop) -> np.ndarray:
     return profiles
 
 
-def tick_profile(loop, slowest: int = 5) -> dict:
+def tick_profile(loop, slowest: int = 5, profiles: np.ndarray | None = None) -> dict:
     """What the loop's kept ticks spent their time on: the slowest ticks part by part, and the slow ones' totals.
 
     A slow tick whose processor time is short and which was preempted lost
     its time to the machine; one with page faults touched new memory; the
     force model's, the cut's and the monitor's parts are the product's own.
     """
-    profiles = kept_tick_profiles(loop)
+    # A copy: the caller's rows (``kept_tick_profiles``, read once) keep their units.
+    profiles = kept_tick_profiles(loop) if profiles is None else np.array(profiles, dtype=float)
     # The deepest contact in micrometres, as the times are kept to a tenth of their unit.
     profiles[:, PROFILE_FIELDS.index("immersion_um")] *= 1000.0
     if not len(profiles):
@@ -435,11 +436,12 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         out_dir / "haptic_session.json")
     tool_pose = vtk.vtkMatrix4x4()
     tool.GetParentTransformNode().GetMatrixTransformToWorld(tool_pose)
-    profile = tick_profile(loop)
+    kept = kept_tick_profiles(loop)
+    profile = tick_profile(loop, profiles=kept)
     machine = None
     if check_machine and profile["ticks"]:
         # The replay's own work, tick by tick; its slowest 1 % cut to its 99th percentile, as those were slowed too.
-        work = kept_tick_profiles(loop)[:, PROFILE_FIELDS.index("cpu_us")]
+        work = kept[:, PROFILE_FIELDS.index("cpu_us")]
         machine = machine_check(loop.GetNumberOfTicks() / RATE_HZ, np.minimum(work, np.percentile(work, 99.0)),
                                 real_time_priority=real_time_priority, frame=frame)
     return {
