@@ -42,10 +42,12 @@ int vtkHapticMachineCheckTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_BOOL(check->GetRealTimePriority() == (std::strstr(check->GetRealTimePriorityStatus(), "SCHED_FIFO priority 80") != nullptr &&
                                                std::strstr(check->GetRealTimePriorityStatus(), "refused") == nullptr), true);
 
-  // The threshold decides what is slow: every tick is slower than 1 us (and bound by its work), none than a second.
+  // The threshold decides what is slow: every tick is slower than 1 us, none than a second. Nearly every tick is
+  // bound by its work too; on a virtual machine that counts stolen time out of a thread's processor time (as here),
+  // a tick whose whole run the host took shows next to none (seen: 1 of 300 in a fresh-clone run).
   check->SetSlowTickTime(1e-6);
   CHECK_INT(static_cast<int>(check->GetNumberOfSlowTicks()), 300);
-  CHECK_INT(static_cast<int>(check->GetNumberOfProcessorBoundSlowTicks()), 300);
+  CHECK_BOOL(check->GetNumberOfProcessorBoundSlowTicks() >= 290 && check->GetNumberOfProcessorBoundSlowTicks() <= 300, true);
   check->SetSlowTickTime(1.0);
   CHECK_INT(static_cast<int>(check->GetNumberOfSlowTicks()), 0);
 
