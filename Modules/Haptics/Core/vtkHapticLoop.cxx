@@ -146,6 +146,10 @@ struct vtkHapticLoop::Internals
   std::atomic<unsigned long long> Timed{ 0 };
   std::atomic<unsigned long long> Jittered{ 0 };
   std::atomic<unsigned long long> Overruns{ 0 };
+  /// Overruns of ticks that the system woke later than the tick then took: the thread was asleep, not working.
+  std::atomic<unsigned long long> LateWakeUpOverruns{ 0 };
+  /// How long after its deadline the system woke the thread at worst (us); written by the haptic thread only.
+  std::atomic<float> MaximumWakeUpLateness{ 0.0f };
   bool RealTime = false;
   /// What the haptic thread asked of the system and got (GetRealTimePriorityStatus), set before ThreadReady.
   std::string RealTimeStatus = "not started";
@@ -653,6 +657,8 @@ bool vtkHapticLoop::Prepare()
   internal.Timed = 0;
   internal.Jittered = 0;
   internal.Overruns = 0;
+  internal.LateWakeUpOverruns = 0;
+  internal.MaximumWakeUpLateness = 0.0f;
   internal.TickCount = 0;
   internal.WasPresent = internal.EverPresent = internal.HaveSample = false;
   internal.NeedsReset = true;
@@ -798,8 +804,14 @@ void vtkHapticLoop::Run()
   bool hasPrevious = false;
   while (!internal.StopRequested.load(std::memory_order_acquire))
   {
-    vtkHapticRealTime::WaitUntil(deadline, spin);
+    const bool waited = vtkHapticRealTime::WaitUntil(deadline, spin);
     const Clock::time_point start = Clock::now();
+    // Woken late: the time from the deadline slept to, where the thread did wait for it.
+    const float lateness = waited ? std::chrono::duration<float, std::micro>(start - deadline).count() : 0.0f;
+    if (lateness > internal.MaximumWakeUpLateness.load(std::memory_order_relaxed))
+    {
+      internal.MaximumWakeUpLateness.store(lateness, std::memory_order_relaxed);
+    }
     const size_t capacity = internal.Durations.size();
     if (hasPrevious)
     {
@@ -818,12 +830,16 @@ void vtkHapticLoop::Run()
     const double processorEnd = vtkHapticRealTime::ThreadProcessorMicroseconds();
     const ThreadCounters countersAfter = vtkHapticRealTime::ReadCounters();
     const Clock::time_point end = Clock::now();
-    internal.KeepTick(
-      std::chrono::duration<float, std::micro>(end - start).count(), static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
+    const float duration = std::chrono::duration<float, std::micro>(end - start).count();
+    internal.KeepTick(duration, static_cast<float>(processorEnd - processorStart), countersBefore, countersAfter);
     deadline += period;
     if (end > deadline)
     {
       internal.Overruns.fetch_add(1, std::memory_order_relaxed);
+      if (lateness > duration)
+      {
+        internal.LateWakeUpOverruns.fetch_add(1, std::memory_order_relaxed);
+      }
       // Late by more than a tick: start afresh rather than burst to catch up.
       if (end > deadline + period)
       {
@@ -1295,6 +1311,18 @@ unsigned long long vtkHapticLoop::GetNumberOfOverruns() const
 }
 
 //------------------------------------------------------------------------------
+unsigned long long vtkHapticLoop::GetNumberOfLateWakeUpOverruns() const
+{
+  return this->Internal->LateWakeUpOverruns.load(std::memory_order_acquire);
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticLoop::GetMaximumWakeUpLateness() const
+{
+  return this->Internal->MaximumWakeUpLateness.load(std::memory_order_acquire);
+}
+
+//------------------------------------------------------------------------------
 double vtkHapticLoop::GetCutDurationPercentile(double percent) const
 {
   const Internals& internal = *this->Internal;
@@ -1407,6 +1435,8 @@ void vtkHapticLoop::ResetStatistics()
   this->Internal->Timed = 0;
   this->Internal->Jittered = 0;
   this->Internal->Overruns = 0;
+  this->Internal->LateWakeUpOverruns = 0;
+  this->Internal->MaximumWakeUpLateness = 0.0f;
   this->Internal->ShieldBricksInTicks = 0;
 }
 

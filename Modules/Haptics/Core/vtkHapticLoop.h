@@ -356,6 +356,19 @@ public:
 
   ///@{
   /**
+   * Overruns the thread slept through: ticks that the system woke later
+   * after their deadline than the tick then took (the tick would have fit
+   * had it started on time), and the latest such waking, in microseconds.
+   * Ticks that start late because the previous one ended late are not
+   * counted. On a virtual machine a sleeping processor is woken when the
+   * host gets round to it: these are the system's, not the tick's work.
+   */
+  unsigned long long GetNumberOfLateWakeUpOverruns() const;
+  double GetMaximumWakeUpLateness() const;
+  ///@}
+
+  ///@{
+  /**
    * Whether the system granted the haptic thread real-time priority at its
    * last Start, and what the thread got, in one line: the policy and level,
    * or why it runs at normal priority (not requested, or the system's

@@ -81,6 +81,8 @@ struct vtkHapticMachineCheck::Internals
   /// Each tick's work (s), cycled: WorkTimes copied at Start, or WorkTime alone.
   std::vector<double> Work;
   vtkIdType Overruns = 0;
+  vtkIdType LateWakeUpOverruns = 0;
+  float MaximumWakeUpLateness = 0.0f;
   double CalibratedWork = 0.0;
   bool RealTime = false;
   std::string RealTimeStatus = "not run";
@@ -118,6 +120,8 @@ bool vtkHapticMachineCheck::Start()
   internal.Durations.clear();
   internal.ProcessorTimes.clear();
   internal.Overruns = 0;
+  internal.LateWakeUpOverruns = 0;
+  internal.MaximumWakeUpLateness = 0.0f;
   internal.CalibratedWork = 0.0;
   internal.RealTime = false;
   internal.RealTimeStatus = "not run";
@@ -210,19 +214,23 @@ void vtkHapticMachineCheck::Measure()
   Clock::time_point deadline = Clock::now() + period;
   for (size_t tick = 0; tick < internal.Ticks; ++tick)
   {
-    vtkHapticRealTime::WaitUntil(deadline, spin);
+    const bool waited = vtkHapticRealTime::WaitUntil(deadline, spin);
     // As the loop measures a tick: processor time read inside the wall-clock interval.
     const Clock::time_point start = Clock::now();
+    const float lateness = waited ? std::chrono::duration<float, std::micro>(start - deadline).count() : 0.0f;
+    internal.MaximumWakeUpLateness = std::max(internal.MaximumWakeUpLateness, lateness);
     const double processorStart = vtkHapticRealTime::ThreadProcessorMicroseconds();
     internal.Sink = ConstantWork(iterations[tick % iterations.size()], internal.Sink);
     const double processorEnd = vtkHapticRealTime::ThreadProcessorMicroseconds();
     const Clock::time_point end = Clock::now();
-    internal.Durations.push_back(std::chrono::duration<float, std::micro>(end - start).count());
+    const float duration = std::chrono::duration<float, std::micro>(end - start).count();
+    internal.Durations.push_back(duration);
     internal.ProcessorTimes.push_back(static_cast<float>(processorEnd - processorStart));
     deadline += period;
     if (end > deadline)
     {
       ++internal.Overruns;
+      internal.LateWakeUpOverruns += lateness > duration;
       if (end > deadline + period)
       {
         deadline = end + period;
@@ -253,6 +261,18 @@ double vtkHapticMachineCheck::GetTickProcessorTimePercentile(double percent) con
 vtkIdType vtkHapticMachineCheck::GetNumberOfOverruns() const
 {
   return this->IsRunning() ? 0 : this->Internal->Overruns;
+}
+
+//------------------------------------------------------------------------------
+vtkIdType vtkHapticMachineCheck::GetNumberOfLateWakeUpOverruns() const
+{
+  return this->IsRunning() ? 0 : this->Internal->LateWakeUpOverruns;
+}
+
+//------------------------------------------------------------------------------
+double vtkHapticMachineCheck::GetMaximumWakeUpLateness() const
+{
+  return this->IsRunning() ? 0.0 : this->Internal->MaximumWakeUpLateness;
 }
 
 //------------------------------------------------------------------------------
@@ -315,7 +335,9 @@ void vtkHapticMachineCheck::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "SpinTime: " << this->SpinTime << " s\n";
   os << indent << "ProcessorIndex: " << this->ProcessorIndex << "\n";
   os << indent << "NumberOfTicks: " << this->GetNumberOfTicks() << "\n";
-  os << indent << "NumberOfOverruns: " << this->GetNumberOfOverruns() << "\n";
+  os << indent << "NumberOfOverruns: " << this->GetNumberOfOverruns() << " (late wake-ups "
+     << this->GetNumberOfLateWakeUpOverruns() << ")\n";
+  os << indent << "MaximumWakeUpLateness: " << this->GetMaximumWakeUpLateness() << " us\n";
   os << indent << "NumberOfSlowTicks: " << this->GetNumberOfSlowTicks() << " (processor-bound "
      << this->GetNumberOfProcessorBoundSlowTicks() << ")\n";
 }

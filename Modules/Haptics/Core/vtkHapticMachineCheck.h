@@ -123,6 +123,12 @@ public:
   /// Ticks that ended after their deadline, as vtkHapticLoop::GetNumberOfOverruns counts them.
   vtkIdType GetNumberOfOverruns() const;
 
+  ///@{
+  /// As vtkHapticLoop's: overruns of ticks woken later than they took, and the latest waking, in microseconds.
+  vtkIdType GetNumberOfLateWakeUpOverruns() const;
+  double GetMaximumWakeUpLateness() const;
+  ///@}
+
   /// Ticks longer than SlowTickTime.
   vtkIdType GetNumberOfSlowTicks() const;
 

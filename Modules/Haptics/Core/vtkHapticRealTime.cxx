@@ -146,10 +146,15 @@ void vtkHapticRealTime::PrepareThread()
 }
 
 //------------------------------------------------------------------------------
-void vtkHapticRealTime::WaitUntil(Clock::time_point deadline, Clock::duration spin)
+bool vtkHapticRealTime::WaitUntil(Clock::time_point deadline, Clock::duration spin)
 {
   const Clock::time_point wake = deadline - spin;
-  if (Clock::now() < wake)
+  const Clock::time_point now = Clock::now();
+  if (!(now < deadline))
+  {
+    return false;
+  }
+  if (now < wake)
   {
 #if defined(__linux__)
     // steady_clock is CLOCK_MONOTONIC (libstdc++ and libc++ on Linux).
@@ -168,6 +173,7 @@ void vtkHapticRealTime::WaitUntil(Clock::time_point deadline, Clock::duration sp
   {
     Relax();
   }
+  return true;
 }
 
 //------------------------------------------------------------------------------

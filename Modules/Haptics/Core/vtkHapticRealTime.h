@@ -64,9 +64,11 @@ public:
   /**
    * Sleep until deadline - spin (clock_nanosleep to an absolute time on
    * POSIX, so that no time is lost computing a relative sleep), then wait
-   * the rest actively.
+   * the rest actively. False when the deadline had already passed (the
+   * previous tick ended late): then how late the tick starts is not the
+   * system's waking.
    */
-  static void WaitUntil(Clock::time_point deadline, Clock::duration spin);
+  static bool WaitUntil(Clock::time_point deadline, Clock::duration spin);
 
   /// Processor time (us) the calling thread has used.
   static double ThreadProcessorMicroseconds();

@@ -266,6 +266,10 @@ def test_main_job_haptics_replays_a_recorded_session_through_the_loop(tmp_path):
     assert machine["display_frames"] == 0  # no views here: the check sleeps a display period between updates
     assert 0 <= machine["slow_ticks_processor_bound"] <= machine["slow_ticks"] <= machine["ticks"]
     assert machine["tick_us_p50"] <= machine["tick_us_p99"] <= machine["tick_us_max"]
+    # Overruns slept through (woken late) are among the overruns, in the loop's figures and the check's alike.
+    for figures in (summary, machine):
+        assert 0 <= figures["overruns_woken_late"] <= figures["overruns"]
+        assert figures["wake_up_lateness_us_max"] >= 0.0
     # The force model's pace per lookup, and each slowest tick's against it.
     assert profile["lookup_us_median"] > 0.0
     assert profile["most_lookups_at_median_pace_us"] == pytest.approx(

@@ -9,7 +9,10 @@
 // the user nobody) the loop still ticks and its status says why it got no
 // real-time priority. At real-time priority the thread must sleep between
 // ticks, or it would hold its processor against the rest of the machine:
-// its processor time stays a fraction of the time it ran.
+// its processor time stays a fraction of the time it ran. An overrun the
+// thread slept through (woken late, here by a real-time thread holding its
+// processor) is counted as such, apart from ticks that worked too long.
+#include "vtkHapticTestProcessorHold.h"
 #include "vtkHapticTestWaiting.h"
 
 #include "vtkHapticForceModel.h"
@@ -218,6 +221,37 @@ int vtkHapticLoopRealTimeTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
     CHECK_INT(CountFIFOThreads(42), 0);
     CHECK_BOOL(Contains(air.Loop->GetRealTimePriorityStatus(), "not requested"), true);
     air.Loop->Stop();
+  }
+
+  {
+    // Held off processor 0 three times for 5 ms while asleep between its ticks over air (a few microseconds
+    // each): three overruns it slept through. The holds fall a third of a period apart in the ticks' phase, so
+    // that at most one can fall in a tick (then the tick itself runs long and is not counted as woken late).
+    AirLoop air;
+    air.Loop->RequestRealTimePriorityOff();
+    air.Loop->SetProcessorIndex(0);
+    CHECK_BOOL(air.Loop->Start(), true);
+    CHECK_BOOL(air.Ticks(20), true);
+    int held = 0;
+    for (int hold = 0; hold < 3; ++hold)
+    {
+      std::this_thread::sleep_for(std::chrono::microseconds(30000 + 333 * hold));
+      held += vtkHapticTestHoldProcessor(0, std::chrono::microseconds(5000));
+    }
+    CHECK_BOOL(air.Ticks(air.Loop->GetNumberOfTicks() + 20), true);
+    air.Loop->Stop();
+    std::cout << "Held " << held << " times: " << air.Loop->GetNumberOfOverruns() << " overruns, "
+              << air.Loop->GetNumberOfLateWakeUpOverruns() << " woken late, latest " << air.Loop->GetMaximumWakeUpLateness()
+              << " us" << std::endl;
+    CHECK_BOOL(air.Loop->GetNumberOfLateWakeUpOverruns() <= air.Loop->GetNumberOfOverruns(), true);
+    if (held == 3)
+    {
+      CHECK_BOOL(air.Loop->GetNumberOfLateWakeUpOverruns() >= 2, true);
+      CHECK_BOOL(air.Loop->GetMaximumWakeUpLateness() >= 3000.0, true);
+    }
+    air.Loop->ResetStatistics();
+    CHECK_INT(static_cast<int>(air.Loop->GetNumberOfLateWakeUpOverruns()), 0);
+    CHECK_DOUBLE(air.Loop->GetMaximumWakeUpLateness(), 0.0);
   }
 #else
   AirLoop air;

@@ -5,17 +5,23 @@
 // multiple of it), counts slow and processor-bound ticks by its threshold,
 // asks for real-time priority as the loop does (or says it was not asked),
 // runs beside its caller (Start, Wait) and refuses a second start, does a
-// sequence of work per tick (a loop's own, cycled), and refuses work that
-// does not fit in a period, leaving nothing measured.
+// sequence of work per tick (a loop's own, cycled), refuses work that
+// does not fit in a period, leaving nothing measured, and tells an overrun
+// it slept through (woken late, as a held processor does) from others.
 #include "vtkHapticMachineCheck.h"
+
+#include "vtkHapticTestProcessorHold.h"
 
 #include <vtkAddonTestingMacros.h>
 
 #include <vtkDoubleArray.h>
 #include <vtkNew.h>
 
+#include <chrono>
 #include <cstring>
+#include <iostream>
 #include <sstream>
+#include <thread>
 
 int vtkHapticMachineCheckTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
 {
@@ -101,9 +107,43 @@ int vtkHapticMachineCheckTest1(int vtkNotUsed(argc), char* vtkNotUsed(argv)[])
   CHECK_BOOL(check->Run(), false);
   TESTING_OUTPUT_ASSERT_ERRORS_END();
   CHECK_INT(static_cast<int>(check->GetNumberOfTicks()), 0);
+  CHECK_INT(static_cast<int>(check->GetNumberOfLateWakeUpOverruns()), 0);
+  CHECK_DOUBLE(check->GetMaximumWakeUpLateness(), 0.0);
+
+  // Woken late on purpose: at normal priority on processor 0, held off it three times for 5 ms by a real-time
+  // thread. Its ticks of 20 us sleep through nearly all of each period, so a hold finds it asleep and it overruns
+  // having slept through its deadline; the holds start a third of a period apart in the ticks' phase, so that at
+  // most one can fall in a tick.
+  check->SetWorkTimes(nullptr);
+  check->SetWorkTime(20e-6);
+  check->SetRequestRealTimePriority(false);
+  check->SetProcessorIndex(0);
+  check->SetDuration(0.5);
+  CHECK_BOOL(check->Start(), true);
+  int held = 0;
+  for (int hold = 0; hold < 3; ++hold)
+  {
+    std::this_thread::sleep_for(std::chrono::microseconds(60000 + 333 * hold));
+    held += vtkHapticTestHoldProcessor(0, std::chrono::microseconds(5000));
+  }
+  check->Wait();
+  std::cout << "Held " << held << " times: " << check->GetNumberOfOverruns() << " overruns, "
+            << check->GetNumberOfLateWakeUpOverruns() << " woken late, latest " << check->GetMaximumWakeUpLateness() << " us"
+            << std::endl;
+  CHECK_BOOL(check->GetNumberOfLateWakeUpOverruns() <= check->GetNumberOfOverruns(), true);
+  if (held == 3)
+  {
+    CHECK_BOOL(check->GetNumberOfLateWakeUpOverruns() >= 2, true);
+    CHECK_BOOL(check->GetMaximumWakeUpLateness() >= 3000.0, true);
+  }
+  else
+  {
+    std::cout << "No real-time priority or pinning here: the late wake-ups were not made" << std::endl;
+  }
 
   std::ostringstream printed;
   check->Print(printed);
   CHECK_BOOL(printed.str().find("WorkTime") != std::string::npos, true);
+  CHECK_BOOL(printed.str().find("MaximumWakeUpLateness") != std::string::npos, true);
   return EXIT_SUCCESS;
 }

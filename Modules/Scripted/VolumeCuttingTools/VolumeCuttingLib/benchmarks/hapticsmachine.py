@@ -15,7 +15,11 @@ machine's alone, the baseline of the loop's. The force
 model's own longest work is the most lookups of any tick at the run's median
 pace per lookup (``tick_profile``'s ``most_lookups_at_median_pace_us``), and
 by a fit of each tick's processor time to its CT-only and cut-field lookups
-over the ticks the machine left alone (``longest_own_work_us``).
+over the ticks the machine left alone (``longest_own_work_us``). The
+overruns are told apart: those the thread slept through (woken later than its
+tick then took) against those it worked through; and a thread doing no work
+at all, only waking each period beside the same view, gives the machine's
+floor of overruns, which no work of the product's can go below.
 """
 
 from __future__ import annotations
@@ -42,7 +46,7 @@ def hapticsmachine(repeats: int) -> list[dict]:
     machine = machine_description(opengl_renderer_name(view.render_window))
     machine["note"] = ("2-core virtual machine shared with other jobs, no GPU; rendering by Mesa llvmpipe on the CPU; "
                        "the kernel charges interrupt time to the interrupted thread (no IRQ_TIME_ACCOUNTING)")
-    replays, stolen = [], []
+    replays, stolen, floors = [], [], []
     with tempfile.TemporaryDirectory() as directory:
         for round_ in range(ROUNDS):
             # Fresh bone each round: a replay into the last one's cavity would have little to touch.
@@ -53,6 +57,7 @@ def hapticsmachine(repeats: int) -> list[dict]:
             before = _stolen_ms()
             replays.append(hapticsjob.run(application, cut_node, plan, folder, frame=view.render))
             stolen.append(_stolen_ms() - before)
+            floors.append(hapticsjob.machine_check(replays[-1]["ticks_run"] / hapticsjob.RATE_HZ, 0.0, frame=view.render))
     checks = [replay["machine_check"] for replay in replays]
     profiles = [replay["tick_profile"] for replay in replays]
     ticks = sum(replay["ticks_run"] for replay in replays)
@@ -74,9 +79,21 @@ def hapticsmachine(repeats: int) -> list[dict]:
     row["work_us_mean"] = [c["work_us_mean_calibrated"] for c in checks]
     row["host_steal_ms"] = [round(ms, 1) for ms in stolen]
     results.append(row)
-    results.append(measurement(f"haptic loop overruns on the {where} (all rounds)",
-                               sum(r["overruns"] for r in replays), "ticks", f"{baseline}: its overruns",
-                               sum(c["overruns"] for c in checks), 1, machine))
+    row = measurement(f"haptic loop overruns on the {where} (all rounds)",
+                      sum(r["overruns"] for r in replays), "ticks", f"{baseline}: its overruns",
+                      sum(c["overruns"] for c in checks), 1, machine)
+    # Slept through: the system woke the thread later than its tick then took.
+    row["woken_late"] = {"loop": sum(r["overruns_woken_late"] for r in replays),
+                         "same_work": sum(c["overruns_woken_late"] for c in checks)}
+    row["wake_up_lateness_us_max"] = {"loop": max(r["wake_up_lateness_us_max"] for r in replays),
+                                      "same_work": max(c["wake_up_lateness_us_max"] for c in checks)}
+    results.append(row)
+    row = measurement(f"haptic loop overruns on the {where}, against the machine's floor (all rounds)",
+                      sum(r["overruns"] for r in replays), "ticks", "a thread of no work at all, only waking each period, as many ticks beside the same view "
+                      "right after each replay: the machine's floor", sum(f["overruns"] for f in floors), 1, machine)
+    row["floor_woken_late"] = sum(f["overruns_woken_late"] for f in floors)
+    row["floor_wake_up_lateness_us_max"] = max(f["wake_up_lateness_us_max"] for f in floors)
+    results.append(row)
     results.append(measurement(f"longest haptic tick on the {where} (max of rounds)",
                                max(r["tick_us_max"] for r in replays), "us", f"{baseline}: its longest tick",
                                max(c["tick_us_max"] for c in checks), ticks, machine))

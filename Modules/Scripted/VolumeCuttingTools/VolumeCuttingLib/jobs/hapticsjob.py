@@ -270,6 +270,8 @@ def machine_check(seconds: float, work_us, real_time_priority: bool = True, fram
         "tick_us_max": round(check.GetTickDurationPercentile(100.0), 1),
         "tick_cpu_us_max": round(check.GetTickProcessorTimePercentile(100.0), 1),
         "overruns": int(check.GetNumberOfOverruns()),
+        "overruns_woken_late": int(check.GetNumberOfLateWakeUpOverruns()),
+        "wake_up_lateness_us_max": round(check.GetMaximumWakeUpLateness(), 1),
         "slow_ticks": int(check.GetNumberOfSlowTicks()),
         "slow_ticks_processor_bound": int(check.GetNumberOfProcessorBoundSlowTicks()),
         "real_time_priority_status": check.GetRealTimePriorityStatus(),
@@ -473,6 +475,9 @@ def run(application, cut_node, plan, out_dir: Path, frame=None, prepare_shield_a
         "tick_cpu_us_max": round(loop.GetTickProcessorTimePercentile(100.0), 1),
         "period_jitter_us_p99": round(loop.GetPeriodJitterPercentile(99.0), 1),
         "overruns": int(loop.GetNumberOfOverruns()),
+        # Overruns the thread slept through: woken later than its tick then took (the system's, not the tick's work).
+        "overruns_woken_late": int(loop.GetNumberOfLateWakeUpOverruns()),
+        "wake_up_lateness_us_max": round(loop.GetMaximumWakeUpLateness(), 1),
         "cut_us_p99": round(loop.GetCutDurationPercentile(99.0), 1),
         "cut_us_max": round(loop.GetCutDurationPercentile(100.0), 1),
         "asynchronous_cutting": bool(loop.GetAsynchronousCutting()),

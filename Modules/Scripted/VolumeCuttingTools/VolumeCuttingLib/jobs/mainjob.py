@@ -565,11 +565,13 @@ def main(argv=None) -> int:
     if machine and haptics.get("overruns"):
         # Overruns alone do not say whose they are: beside them, what the same work got on this machine without the product's code.
         profile = haptics["tick_profile"]
-        print(f"note: the haptic loop overran {haptics['overruns']} times ({profile['slow_ticks']} ticks over "
+        print(f"note: the haptic loop overran {haptics['overruns']} times ({haptics['overruns_woken_late']} asleep: woken up "
+              f"to {haptics['wake_up_lateness_us_max']:.0f} us late; {profile['slow_ticks']} ticks over "
               f"{profile['slow_tick_us']:.0f} us, {profile['slow_ticks_processor_bound']} processor-bound); a thread doing "
               f"the same work, tick by tick, without memory, beside the same views overran {machine['overruns']} "
-              f"times ({machine['slow_ticks']} over, {machine['slow_ticks_processor_bound']} processor-bound): "
-              f"what this machine does to that work alone", file=sys.stderr)
+              f"times ({machine['overruns_woken_late']} asleep; {machine['slow_ticks']} over, "
+              f"{machine['slow_ticks_processor_bound']} processor-bound): what this machine does to that work alone",
+              file=sys.stderr)
     return 0 if summary["inputs_ok"] else 1
 
 
