@@ -20,10 +20,15 @@
  * rises above it, so a sliver of about a quarter voxel between them belongs
  * to neither. The march used to end there: a thick wall read as thin
  * wherever a step landed in the sliver, which gave red flecks and bands
- * across drilled floors (issue 28). A gap of no material shorter than
- * GapBridgeSteps steps, with material again beyond it, is therefore
- * crossed as part of the wall; no air cell or canal a CT resolves is that
- * thin.
+ * across drilled floors (issue 28). A segment drawn slice by slice has
+ * slices drawn a little larger than the next: each leaves a ledge one slice
+ * thick over a notch about a voxel deep, and a march from the ledge down
+ * through it left the material there, so every terrace of the temporal
+ * bone's mastoid drew a line of red flecks (issue 28, finding 9). A gap of
+ * no material shorter than GapBridgeSteps steps (a voxel and a half), with
+ * material again beyond it, is therefore crossed as part of the wall; no
+ * air cell or canal a CT resolves is that thin (it takes two voxels to
+ * show air between bone).
  */
 #ifndef vtkVolumeCutThinBoneShader_h
 #define vtkVolumeCutThinBoneShader_h
@@ -78,7 +83,7 @@ public:
   static constexpr int CrossingHalvings = 6;
 
   /// The longest gap without material (in march steps, a quarter voxel each) still counted as part of a wall.
-  static constexpr int GapBridgeSteps = 2;
+  static constexpr int GapBridgeSteps = 6;
 
   /// Tint a shaded surface colour and its opacity by the wall's thickness there.
   void Apply(const double index[3], const double normalWorld[3], float rgb[3], float& alpha) const

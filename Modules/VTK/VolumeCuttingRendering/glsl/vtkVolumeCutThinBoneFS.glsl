@@ -22,13 +22,14 @@ bool insideVolume(vec3 p)
   return !(any(lessThan(p, vec3(0.0))) || any(greaterThan(p, vec3(dimensions - 1))));
 }
 
-// Whether material is visible again within two steps (half a voxel) beyond
-// a sample without it, and how far along: the sliver between two shown
-// segments' smoothed labels is part of the wall
+// Whether material is visible again within six steps (a voxel and a half)
+// beyond a sample without it, and how far along: the sliver between two
+// shown segments' smoothed labels and the notch under a slice drawn larger
+// than the next are part of the wall
 // (vtkVolumeCutThinBoneShader::GapBridgeSteps says why).
 bool materialAgainWithin(vec3 index, vec3 inwardIndex, float stepLength, inout float travelled)
 {
-  for (int ahead = 1; ahead <= 2; ++ahead)
+  for (int ahead = 1; ahead <= 6; ++ahead)
   {
     vec3 p = index + (travelled + float(ahead) * stepLength) * inwardIndex;
     if (!insideVolume(p))
