@@ -40,6 +40,8 @@ REPO = HERE.parent.parent
 PYTHON_VERSION = (3, 11)
 APT_PACKAGES = [
     "g++", "cmake", "ninja-build", "pkg-config",
+    # Utilities/vc compiles through it when present: a fresh clone on the same machine recompiles only what changed.
+    "ccache",
     "libhidapi-dev", "libusb-1.0-0-dev",
     # The device backends' tests fake USB and hidraw devices in user space.
     "umockdev", "libumockdev-dev",
